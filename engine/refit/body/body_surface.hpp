@@ -1,0 +1,39 @@
+#pragma once
+// Geometric queries on a body surface through Embree 3: closest point, signed
+// distance and a robust inside test. Thread-safe for queries after construction.
+#include <refit/body/body_mesh.hpp>
+
+#include <memory>
+
+namespace refit {
+
+struct ClosestPoint {
+  Vec3 point = Vec3::Zero();
+  Vec3 normal = Vec3::Zero();  // unit face normal of the closest triangle (outward for an outward-oriented body)
+  double distance = 0.0;       // unsigned
+  Index triangle = 0;
+};
+
+class BodySurface {
+ public:
+  explicit BodySurface(const BodyMesh& body);
+  ~BodySurface();
+  BodySurface(BodySurface&&) noexcept;
+  BodySurface& operator=(BodySurface&&) noexcept;
+
+  ClosestPoint closest(const Vec3& p) const;
+  /// Closest point no farther than max_distance; distance = +inf when none.
+  ClosestPoint closest_within(const Vec3& p, double max_distance) const;
+  /// True when p is inside the closed body (ray parity, majority over several directions).
+  bool inside(const Vec3& p) const;
+  /// Negative inside, positive outside.
+  double signed_distance(const Vec3& p) const;
+  /// Ray cast: distance along unit dir to the first hit, +inf if none; tri_out gets the triangle.
+  double intersect(const Vec3& origin, const Vec3& dir, Index* tri_out = nullptr) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace refit

@@ -1,0 +1,25 @@
+#pragma once
+// The garment data model: positions SoA plus polygon faces, polylines (`l`) and
+// points (`p`) in CSR form. Faces may be of any size and non-manifold; vertices
+// may be used by nothing. `source` keeps the original file text so a writer can
+// give the file back line for line with only the positions changed.
+#include <refit/core/types.hpp>
+
+#include <memory>
+#include <string>
+
+namespace refit {
+
+struct ObjSource;  // defined in <refit/io/obj_garment.hpp>
+
+struct Garment {
+  Points positions;  // n x 3
+  Csr faces;         // polygon corners (vertex indices), any size >= 3
+  Csr lines;         // `l` polylines, >= 2 vertices each
+  Csr points;        // `p` elements, >= 1 vertex each
+  std::shared_ptr<const ObjSource> source;  // null for generated garments
+
+  std::size_t vertex_count() const { return static_cast<std::size_t>(positions.rows()); }
+};
+
+}  // namespace refit

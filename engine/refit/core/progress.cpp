@@ -1,0 +1,24 @@
+#include <refit/core/progress.hpp>
+
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+namespace refit {
+
+void Progress::stage(const std::string& what) const {
+  if (quiet_) return;
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  std::fprintf(stderr, "[refit %7.2fs] %s\n", s, what.c_str());
+}
+
+double peak_memory_mb() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+  }
+  return 0.0;
+}
+
+}  // namespace refit

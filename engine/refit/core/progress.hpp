@@ -1,0 +1,34 @@
+#pragma once
+// Progress lines on stderr for long runs; silent when quiet.
+#include <chrono>
+#include <string>
+
+namespace refit {
+
+class Progress {
+ public:
+  explicit Progress(bool quiet = false) : quiet_(quiet) {}
+  void stage(const std::string& what) const;
+  bool quiet() const { return quiet_; }
+
+ private:
+  bool quiet_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+/// Wall-clock milliseconds since construction.
+class Stopwatch {
+ public:
+  double ms() const {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count();
+  }
+  void reset() { start_ = std::chrono::steady_clock::now(); }
+
+ private:
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+/// Peak resident set size of this process in MB (VmHWM), 0 if unknown.
+double peak_memory_mb();
+
+}  // namespace refit

@@ -1,0 +1,26 @@
+#pragma once
+// Topology of a garment as a CAD file gives it (non-manifold, soups, hanging
+// edges, loose points): edge incidence, boundary loops and connected components.
+#include <refit/core/garment.hpp>
+
+#include <vector>
+
+namespace refit {
+
+struct TopologyStats {
+  std::size_t vertices = 0, faces = 0, lines = 0, points = 0;
+  std::size_t unreferenced_vertices = 0;  // used by no face, line or point
+  std::size_t edges = 0;                  // distinct undirected face edges
+  std::size_t boundary_edges = 0;         // face edges with exactly one face
+  std::size_t non_manifold_edges = 0;     // face edges with three or more faces
+  std::size_t boundary_loops = 0;
+  std::size_t components = 0;             // over faces, lines and points together (unreferenced vertices excluded)
+};
+
+TopologyStats topology_stats(const Garment& g);
+
+/// Boundary loops of the faces (edges used by exactly one face), each an ordered
+/// closed vertex cycle (first vertex not repeated). Deterministic order.
+std::vector<std::vector<Index>> boundary_loops(const Garment& g);
+
+}  // namespace refit

@@ -1,0 +1,39 @@
+#pragma once
+// Basic value types shared by every stage: positions are structure-of-arrays
+// (an Eigen n x 3 column-major matrix keeps x, y and z in separate arrays) and
+// topology is CSR (offsets + indices).
+#include <Eigen/Core>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace refit {
+
+using Index = std::uint32_t;
+using Vec3 = Eigen::Vector3d;
+/// n x 3, column-major: x, y and z each contiguous (SoA).
+using Points = Eigen::Matrix<double, Eigen::Dynamic, 3>;
+
+/// Compressed rows: row r holds indices[offsets[r] .. offsets[r+1]).
+struct Csr {
+  std::vector<Index> offsets{0};
+  std::vector<Index> indices;
+
+  std::size_t rows() const { return offsets.size() - 1; }
+  std::size_t row_size(std::size_t r) const { return offsets[r + 1] - offsets[r]; }
+  std::span<const Index> row(std::size_t r) const {
+    return {indices.data() + offsets[r], indices.data() + offsets[r + 1]};
+  }
+  void push_row(std::span<const Index> row) {
+    indices.insert(indices.end(), row.begin(), row.end());
+    offsets.push_back(static_cast<Index>(indices.size()));
+  }
+  void clear() {
+    offsets.assign(1, 0);
+    indices.clear();
+  }
+};
+
+inline Vec3 row3(const Points& p, Index i) { return p.row(i).transpose(); }
+
+}  // namespace refit

@@ -1,0 +1,35 @@
+#pragma once
+// Shared helpers for the test suites: temporary folders, the shared data folder,
+// running the command line.
+#include <filesystem>
+#include <string>
+
+namespace refit::test {
+
+/// A fresh empty folder under the system temp dir, removed on destruction.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  const std::filesystem::path& path() const { return path_; }
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// ../shared/data, or "" when absent (tests then GTEST_SKIP with a clear message).
+std::string shared_data_dir();
+
+struct CommandResult {
+  int exit_code = 0;
+  std::string out;  // stdout
+  std::string err;  // stderr
+};
+/// Runs `refit <args>` (the built CLI) through the shell.
+CommandResult run_cli(const std::string& args);
+
+std::string read_text(const std::string& path);
+void write_text(const std::string& path, const std::string& text);
+
+}  // namespace refit::test

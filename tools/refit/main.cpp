@@ -1,0 +1,49 @@
+// `refit`: the command line. Every error reaches the user as one line on stderr
+// and a non-zero exit; commands write their outputs atomically.
+#include "command.hpp"
+
+#include <refit/core/error.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+
+namespace refit::cli {
+std::vector<CommandInfo>& registry() {
+  static std::vector<CommandInfo> commands;
+  return commands;
+}
+}  // namespace refit::cli
+
+int main(int argc, char** argv) {
+  using namespace refit::cli;
+  CLI::App app{"refit: resize 3D garments to new bodies while keeping their designed shape"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "refit 0.1.0");
+  auto& commands = registry();
+  std::sort(commands.begin(), commands.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
+  std::vector<std::pair<CLI::App*, std::function<int()>>> actions;
+  for (auto& c : commands) {
+    CLI::App* sub = app.add_subcommand(c.name, c.description);
+    actions.emplace_back(sub, c.setup(*sub));
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  try {
+    for (auto& [sub, action] : actions)
+      if (sub->parsed()) return action();
+  } catch (const refit::Error& e) {
+    std::fprintf(stderr, "refit: error: %s\n", e.what());
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "refit: error: out of memory\n");
+    return 3;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "refit: internal error: %s\n", e.what());
+    return 2;
+  }
+  return 0;
+}
