@@ -3,6 +3,7 @@
 // (an Eigen n x 3 column-major matrix keeps x, y and z in separate arrays) and
 // topology is CSR (offsets + indices).
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <span>
 #include <vector>

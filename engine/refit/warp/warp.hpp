@@ -18,18 +18,22 @@ struct WarpOptions {
   std::size_t max_triangles = 64;  // cap on the triangle set far from the body
 };
 
-/// What the warp of a fixed point set needs from body A: per point, its
-/// triangles (CSR) and local coordinates (one row per CSR entry).
+/// What the warp of a fixed point set needs from body A: the points, and per
+/// point its triangle set (CSR, nearest first). Local coordinates are not
+/// stored: frames are orthonormal, so u_i*u' + v_i*v' + w_i*w' = M_i (p - c_i)
+/// with M_i = F'_i F_i^T, and |(u_i, v_i, w_i)| = |p - c_i|; apply forms M_i once
+/// per triangle. This keeps a binding at 4 bytes per (point, triangle) pair.
 struct WarpBinding {
-  Csr triangles;
-  Points local;          // rows match triangles.indices
-  std::size_t capped = 0;  // points whose triangle set hit max_triangles
+  Points points;                                     // bound positions around body A
+  Csr triangles;                                     // per point: eq. 2 set, capped
+  std::shared_ptr<const TriangleFrames> reference;   // body A's frames
+  std::size_t capped = 0;                            // points whose set hit max_triangles
 
   std::size_t size() const { return triangles.rows(); }
-  /// Warped positions on a body with frames `b` (same connectivity as A).
+  /// Warped positions (eq. 4) on a body whose frames are `b` (same connectivity
+  /// as A). Triangles degenerate on B are left out of the blend; a point whose
+  /// whole set is degenerate on B follows its nearest triangle's centre.
   Points apply(const TriangleFrames& b) const;
-  /// Warped position of point i alone.
-  Vec3 apply_one(const TriangleFrames& b, std::size_t i) const;
 };
 
 /// Body A prepared for binding: frames and the k-d tree over valid triangle centres.
@@ -37,7 +41,7 @@ class ReferenceBody {
  public:
   explicit ReferenceBody(BodyMesh body, WarpOptions options = {});
   const BodyMesh& mesh() const { return body_; }
-  const TriangleFrames& frames() const { return frames_; }
+  const TriangleFrames& frames() const { return *frames_; }
   const PointTree& centres() const { return tree_; }
   const WarpOptions& options() const { return options_; }
 
@@ -47,7 +51,7 @@ class ReferenceBody {
  private:
   BodyMesh body_;
   WarpOptions options_;
-  TriangleFrames frames_;
+  std::shared_ptr<const TriangleFrames> frames_;
   PointTree tree_;
 };
 
