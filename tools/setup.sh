@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Sets up a fresh Debian machine for Refit and builds it.
+#   bash tools/setup.sh          install packages, configure and build (Release)
+#   bash tools/setup.sh demo     ... then run `refit demo` and say where its output is
+#   bash tools/setup.sh test     ... then run the whole test suite through CTest
+# Installing is idempotent and quiet when every package is already there.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(cmake ninja-build g++ pkg-config libtbb-dev libeigen3-dev libembree-dev libopenmesh-dev
+          libgtest-dev libgmock-dev libbenchmark-dev libnanoflann-dev nlohmann-json3-dev libstb-dev
+          libcli11-dev)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  echo "setup: installing ${missing[*]}"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+jobs=$(nproc)
+cmake --preset release >/dev/null
+cmake --build --preset release -j "$jobs"
+
+case "${1:-build}" in
+  build) ;;
+  demo)
+    out="${2:-demo-output}"
+    build/release/tools/refit demo --out-dir "$out"
+    echo "demo output: $(cd "$out" && pwd)"
+    ;;
+  test)
+    ctest --preset release -j "$jobs"
+    ;;
+  *) echo "usage: tools/setup.sh [build|demo [DIR]|test]" >&2; exit 2 ;;
+esac
