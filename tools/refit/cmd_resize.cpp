@@ -7,6 +7,7 @@
 #include <refit/core/parallel.hpp>
 #include <refit/io/body_io.hpp>
 #include <refit/io/obj_garment.hpp>
+#include <refit/features/curves_obj.hpp>
 #include <refit/pipeline/resize.hpp>
 
 #include <cstdio>
@@ -16,10 +17,12 @@ namespace refit::cli {
 namespace {
 
 struct ResizeArgs {
-  std::string garment, from, out, out_dir, report, units = "cm", stage = "full";
+  std::string garment, from, out, out_dir, report, features, curves_out, units = "cm", stage = "full";
   std::vector<std::string> to;
   std::size_t threads = 0, max_triangles = WarpOptions{}.max_triangles;
-  bool quiet = false;
+  bool quiet = false, no_shape_control = false, no_collision = false, encode_on_warped = false;
+  SurfaceOptions surface;
+  double clearance = 0.2;
 };
 
 Stage parse_stage(const std::string& s) {
@@ -40,13 +43,22 @@ int run(const ResizeArgs& a) {
   options.units = a.units;
   options.stage = parse_stage(a.stage);
   options.warp.max_triangles = a.max_triangles;
+  options.surface = a.surface;
+  options.surface.encode_on_warped = a.encode_on_warped;
+  options.collision = !a.no_collision;
+  options.clearance_cm = a.clearance;
+  if (!a.curves_out.empty() && a.features.empty()) throw Error("--curves-out needs --features");
+  if (!a.curves_out.empty() && a.to.size() > 1) throw Error("--curves-out works with one --to body");
 
   Stopwatch clock;
   progress.stage("reading " + a.garment);
   auto garment = std::make_shared<const Garment>(read_garment_obj(a.garment));
   BodyMesh body_a = read_body(a.from);
   const double load_ms = clock.ms();
-  const GarmentBinding binding(garment, std::move(body_a), options, progress);
+  std::vector<FeatureSpec> features;
+  if (!a.features.empty()) features = read_feature_file(a.features, a.units);
+  if (a.no_shape_control) options.stage = Stage::Warp;
+  const GarmentBinding binding(garment, std::move(body_a), options, std::move(features), progress);
 
   if (!a.out_dir.empty()) std::filesystem::create_directories(a.out_dir);
   nlohmann::json reports = nlohmann::json::array();
@@ -64,10 +76,11 @@ int run(const ResizeArgs& a) {
       Garment resized = *garment;
       resized.positions = std::move(result.positions);
       const ObjWriteReport written = write_garment_obj(out, resized);
+      if (!a.curves_out.empty()) write_curves_obj(a.curves_out, result.features);
       nlohmann::json& r = result.report;
       r["timings_ms"]["write"] = clock.ms();
       r["timings_ms"]["load"] = load_ms + load_b_ms;
-      r["timings_ms"]["bind"] = binding.bind_ms();
+      r["timings_ms"]["bind"] = binding.bind_report();
       r["timings_ms"]["total"] = total.ms();
       for (const auto& w : written.warnings) result.warnings.push_back(w);
       if (written.normals_recomputed > 0)
@@ -116,6 +129,19 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
   app.add_option("--stage", a->stage, "Stop after: warp, features or full")->capture_default_str();
   app.add_option("--threads", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
   app.add_option("--max-triangles", a->max_triangles, "Cap on the warp's triangle set per vertex")->capture_default_str();
+  app.add_option("--features", a->features, "Feature curves (JSON) whose shape must survive");
+  app.add_option("--curves-out", a->curves_out, "Write original, warped and optimised feature curves (OBJ l lines)");
+  app.add_flag("--no-shape-control", a->no_shape_control, "The warp alone (same as --stage warp)");
+  app.add_option("--voxel", a->surface.voxel, "Agent voxel size in cm (0 = from the garment size and --agents)")
+      ->capture_default_str();
+  app.add_option("--agents", a->surface.agent_budget, "Agent budget for the automatic voxel size")->capture_default_str();
+  app.add_option("--epsilon", a->surface.epsilon, "Agents closer than this to body B (cm) keep their warped position")
+      ->capture_default_str();
+  app.add_option("--max-iterations", a->surface.max_iterations, "Gauss-Seidel iterations, at most")->capture_default_str();
+  app.add_option("--tolerance", a->surface.tolerance, "Gauss-Seidel stops below this update norm")->capture_default_str();
+  app.add_flag("--encode-on-warped", a->encode_on_warped, "Encode the local shape on the warped garment, not the original");
+  app.add_flag("--no-collision", a->no_collision, "Do not push vertices inside body B out");
+  app.add_option("--clearance", a->clearance, "Collision clearance outside body B in cm")->capture_default_str();
   app.add_flag("--quiet", a->quiet, "No progress on stderr");
   return [a]() { return run(*a); };
 });

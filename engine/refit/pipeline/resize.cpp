@@ -1,8 +1,100 @@
+#include <refit/body/body_surface.hpp>
+#include <refit/body/centre_tree.hpp>
 #include <refit/core/error.hpp>
+#include <refit/features/curve_metrics.hpp>
+#include <refit/features/feature_curves.hpp>
 #include <refit/pipeline/resize.hpp>
 #include <refit/pipeline/units.hpp>
 
 namespace refit {
+
+namespace {
+
+Points concat_rows(const std::vector<const Points*>& parts) {
+  Eigen::Index n = 0;
+  for (const Points* p : parts) n += p->rows();
+  Points out(n, 3);
+  Eigen::Index r = 0;
+  for (const Points* p : parts) {
+    out.middleRows(r, p->rows()) = *p;
+    r += p->rows();
+  }
+  return out;
+}
+
+nlohmann::json surface_report(const SurfaceStats& s) {
+  return {{"agents", s.agents},
+          {"garment_agents", s.garment_agents},
+          {"feature_agents", s.feature_agents},
+          {"voxel", s.voxel},
+          {"voxel_auto", s.voxel_was_auto},
+          {"one_ring_degree_mean", s.ring_degree_mean},
+          {"one_ring_degree_max", s.ring_degree_max},
+          {"fixed_body", s.fixed_body},
+          {"fixed_feature", s.fixed_feature},
+          {"anchored", s.anchored},
+          {"anchored_groups", s.anchored_groups},
+          {"iterations", s.iterations},
+          {"final_update", s.final_update},
+          {"converged", s.converged},
+          {"vertices_without_agent", s.vertices_without_agent},
+          {"timings_ms",
+           {{"sample", s.ms.sample},
+            {"agents", s.ms.agents},
+            {"one_ring", s.ms.one_ring},
+            {"encode", s.ms.encode},
+            {"solve", s.ms.solve},
+            {"reconstruct", s.ms.reconstruct}}}};
+}
+
+// Where the output garment puts each feature sample: the sample follows the
+// inverse-distance blend of its nearest original vertices, so the reported
+// output shape error measures the written surface, not the optimised curve.
+struct SampleAttachment {
+  std::vector<std::array<Index, 4>> vertex;
+  std::vector<std::array<double, 4>> weight;
+  Points offset;
+};
+
+SampleAttachment attach(const PointTree& tree, const Points& original, const Points& samples) {
+  SampleAttachment a;
+  const auto n = samples.rows();
+  a.vertex.resize(static_cast<std::size_t>(n));
+  a.weight.resize(static_cast<std::size_t>(n));
+  a.offset.resize(n, 3);
+  std::vector<Index> idx;
+  std::vector<double> d2;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Vec3 p = samples.row(i).transpose();
+    tree.knn(p, 4, idx, d2);
+    double wsum = 0;
+    Vec3 blend = Vec3::Zero();
+    for (std::size_t k = 0; k < 4; ++k) {
+      const std::size_t j = std::min(k, idx.size() - 1);
+      a.vertex[i][k] = idx[j];
+      a.weight[i][k] = 1.0 / (1e-12 + d2[j]);
+      wsum += a.weight[i][k];
+    }
+    for (std::size_t k = 0; k < 4; ++k) {
+      a.weight[i][k] /= wsum;
+      blend += a.weight[i][k] * row3(original, a.vertex[i][k]);
+    }
+    a.offset.row(i) = (p - blend).transpose();
+  }
+  return a;
+}
+
+Points place(const SampleAttachment& a, const Points& positions) {
+  Points out(a.offset.rows(), 3);
+  for (Eigen::Index i = 0; i < out.rows(); ++i) {
+    Vec3 q = a.offset.row(i).transpose();
+    for (std::size_t k = 0; k < 4; ++k) q += a.weight[i][k] * row3(positions, a.vertex[i][k]);
+    out.row(i) = q.transpose();
+  }
+  return out;
+}
+
+}  // namespace
 
 nlohmann::json garment_summary(const Garment& g) {
   return {{"vertices", g.vertex_count()},
@@ -11,38 +103,131 @@ nlohmann::json garment_summary(const Garment& g) {
           {"points", g.points.rows()}};
 }
 
+GarmentBinding::~GarmentBinding() = default;
+
 GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh body_a, ResizeOptions options,
-                               const Progress& progress)
-    : garment_(std::move(garment)), options_(std::move(options)), body_a_((check_body(body_a), std::move(body_a)), options_.warp) {
-  units_per_cm(options_.units);  // validates the unit name
+                               std::vector<FeatureSpec> features, const Progress& progress)
+    : garment_(std::move(garment)),
+      options_(std::move(options)),
+      body_a_((check_body(body_a), std::move(body_a)), options_.warp) {
+  const double per_cm = units_per_cm(options_.units);
   if (garment_->vertex_count() == 0) throw Error("garment: empty garment (no vertices)");
+  if (!garment_->positions.allFinite()) throw Error("garment: a vertex position is NaN or infinite");
+
   Stopwatch clock;
   progress.stage("binding " + std::to_string(garment_->vertex_count()) + " garment vertices to " + body_a_.mesh().name);
   warp_ = body_a_.bind(garment_->positions);
-  bind_ms_ = clock.ms();
+  bind_report_["warp"] = clock.ms();
+
+  if (options_.stage == Stage::Warp) return;
+  if (!features.empty()) {
+    clock.reset();
+    progress.stage("sampling " + std::to_string(features.size()) + " feature curves");
+    features_ = bind_features(body_a_, build_feature_curves(*garment_, features));
+    bind_report_["features"] = clock.ms();
+  }
+  if (options_.stage == Stage::Full) {
+    clock.reset();
+    progress.stage("building the agent system");
+    SurfaceOptions so = options_.surface;
+    so.epsilon *= per_cm;
+    so.voxel *= per_cm;
+    std::vector<const Points*> samples;
+    if (features_)
+      for (const FeatureCurve& c : features_->model.curves) samples.push_back(&c.samples);
+    surface_ = SurfaceBinding::bind(*garment_, concat_rows(samples), so);
+    bind_report_["surface"] = clock.ms();
+  }
 }
 
 ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& progress) const {
   check_body(body_b);
   check_same_connectivity(body_a_.mesh(), body_b);
   ResizeResult result;
-  nlohmann::json& timings = result.report["timings_ms"];
+  nlohmann::json& report = result.report;
+  nlohmann::json& timings = report["timings_ms"];
   Stopwatch clock;
 
   // Step 1: primary resizing (section 3).
   progress.stage("warping to " + body_b.name);
   const TriangleFrames frames_b = compute_frames(body_b);
-  result.positions = warp_.apply(frames_b);
+  result.warped = warp_.apply(frames_b);
   timings["warp"] = clock.ms();
-  result.report["warp"] = {{"alpha", options_.warp.alpha},
-                           {"max_triangles", options_.warp.max_triangles},
-                           {"capped_vertices", warp_.capped},
-                           {"degenerate_triangles_a", body_a_.frames().degenerate},
-                           {"degenerate_triangles_b", frames_b.degenerate}};
+  report["warp"] = {{"alpha", options_.warp.alpha},
+                    {"max_triangles", options_.warp.max_triangles},
+                    {"capped_vertices", warp_.capped},
+                    {"degenerate_triangles_a", body_a_.frames().degenerate},
+                    {"degenerate_triangles_b", frames_b.degenerate}};
   if (body_a_.frames().degenerate + frames_b.degenerate > 0)
     result.warnings.push_back(std::to_string(body_a_.frames().degenerate) + " degenerate triangles on body A and " +
                               std::to_string(frames_b.degenerate) + " on body B were skipped");
-  if (!result.positions.allFinite()) throw Error("internal: the warp produced a non-finite position");
+  if (!result.warped.allFinite()) throw Error("internal: the warp produced a non-finite position");
+  result.positions = result.warped;
+  if (options_.stage == Stage::Warp) return result;
+
+  clock.reset();
+  const BodySurface surface_b(body_b);
+  const auto distance_b = [&](const Vec3& p) { return surface_b.closest(p).distance; };
+
+  // Step 2: feature curves keep their shape (section 4).
+  FeatureResult& curves = result.features;
+  if (features_) {
+    progress.stage("optimising " + std::to_string(features_->model.curves.size()) + " feature curves");
+    curves = optimise_features(*features_, frames_b, distance_b);
+    timings["features"] = clock.ms();
+    nlohmann::json& list = report["features"];
+    list = nlohmann::json::array();
+    for (const CurveResult& c : curves.curves) {
+      nlohmann::json fixed = nlohmann::json::array();
+      for (const FixedSample& f : c.fixed) fixed.push_back({{"index", f.index}, {"reason", f.reason}, {"distance", f.distance}});
+      nlohmann::json crossings = nlohmann::json::array();
+      for (const FixedSample& f : c.crossings) crossings.push_back({{"index", f.index}, {"distance", f.distance}});
+      list.push_back({{"name", c.name},
+                      {"samples", c.original.rows()},
+                      {"closed", c.closed},
+                      {"fixed", fixed},
+                      {"crossings", crossings},
+                      {"shape_error_warped", c.shape_error_warped},
+                      {"shape_error_result", c.shape_error_result},
+                      {"turning_angle_change_warped_deg", c.turning_angle_change_warped_deg},
+                      {"turning_angle_change_result_deg", c.turning_angle_change_result_deg}});
+    }
+  }
+
+  // Step 3: the surface follows the curves and keeps its local shape (section 5).
+  if (surface_) {
+    clock.reset();
+    progress.stage("optimising the surface (" + std::to_string(surface_->agent_count()) + " agents)");
+    std::vector<const Points*> targets, warped;
+    for (const CurveResult& c : curves.curves) {
+      targets.push_back(&c.optimised);
+      warped.push_back(&c.warped);
+    }
+    const Points feature_warped = concat_rows(warped);
+    SurfaceResult s = surface_->apply(result.warped, concat_rows(targets), surface_b, &feature_warped);
+    timings["surface"] = clock.ms();
+    report["surface"] = surface_report(s.stats);
+    result.positions = std::move(s.positions);
+    if (s.stats.anchored > 0)
+      result.warnings.push_back(std::to_string(s.stats.anchored) + " agents in " + std::to_string(s.stats.anchored_groups) +
+                                " groups with no fixed agent were anchored at their warped positions");
+    if (!s.stats.converged)
+      result.warnings.push_back("surface solve stopped after " + std::to_string(s.stats.iterations) +
+                                " iterations with update " + std::to_string(s.stats.final_update));
+
+    // How the written surface carries each feature (not just the optimised curve).
+    if (features_) {
+      const PointTree tree(garment_->positions);
+      auto& list = report["features"];
+      for (std::size_t i = 0; i < curves.curves.size(); ++i) {
+        const CurveResult& c = curves.curves[i];
+        const SampleAttachment at = attach(tree, garment_->positions, c.original);
+        const Points on_output = place(at, result.positions);
+        list[i]["shape_error_output"] = shape_error(on_output, c.original, c.closed);
+      }
+    }
+  }
+  if (!result.positions.allFinite()) throw Error("internal: the surface step produced a non-finite position");
   return result;
 }
 

@@ -5,54 +5,71 @@
 #include <refit/body/body_mesh.hpp>
 #include <refit/core/garment.hpp>
 #include <refit/core/progress.hpp>
+#include <refit/features/feature_file.hpp>
+#include <refit/features/shape_matching.hpp>
+#include <refit/surface/surface.hpp>
 #include <refit/warp/warp.hpp>
 
 #include <nlohmann/json.hpp>
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace refit {
 
+/// How far a resize goes: the warp alone (step 1), warp + feature curves (steps
+/// 1-2: the garment is the warp, the curves are optimised), or all three steps.
 enum class Stage { Warp, Features, Full };
 
 struct ResizeOptions {
-  std::string units = "cm";
-  WarpOptions warp;
+  std::string units = "cm";    // garment units; physical constants below are in cm
   Stage stage = Stage::Full;
+  WarpOptions warp;
+  SurfaceOptions surface;      // epsilon and voxel in cm here; converted to garment units
+  bool collision = true;       // push vertices inside body B out (beyond the paper)
+  double clearance_cm = 0.2;   // ... to this distance outside the body
 };
 
 struct ResizeResult {
-  Points positions;             // every garment vertex, in file order
-  nlohmann::json report;        // stage timings (ms), counts, per-stage details
+  Points positions;                 // every garment vertex, in file order
+  Points warped;                    // the warp alone (step 1), for comparison
+  FeatureResult features;           // per feature curve: original, warped, optimised samples
+  nlohmann::json report;            // stage timings (ms), counts, per-stage details
   std::vector<std::string> warnings;
 };
 
-/// What depends only on the garment and body A (and later its features),
-/// computed once; `resize` does only what body B changes.
+/// What depends only on the garment, its features and body A, computed once;
+/// `resize` does only what body B changes.
 class GarmentBinding {
  public:
-  /// Throws refit::Error for an empty garment or a bad body A.
+  /// Throws refit::Error for an empty garment, a bad body A, or features that
+  /// miss the garment.
   GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh body_a, ResizeOptions options = {},
-                 const Progress& progress = Progress(true));
+                 std::vector<FeatureSpec> features = {}, const Progress& progress = Progress(true));
+  ~GarmentBinding();
 
   /// Resizes the garment to body B (same connectivity as A, else refit::Error).
   ResizeResult resize(const BodyMesh& body_b, const Progress& progress = Progress(true)) const;
 
   const Garment& garment() const { return *garment_; }
   const ReferenceBody& body_a() const { return body_a_; }
-  double bind_ms() const { return bind_ms_; }
+  const ResizeOptions& options() const { return options_; }
+  /// Bind timings (ms): warp, features, surface.
+  const nlohmann::json& bind_report() const { return bind_report_; }
 
  private:
   std::shared_ptr<const Garment> garment_;
   ResizeOptions options_;
   ReferenceBody body_a_;
   WarpBinding warp_;
-  double bind_ms_ = 0.0;
+  std::optional<FeatureBinding> features_;
+  std::optional<SurfaceBinding> surface_;
+  nlohmann::json bind_report_;
 };
 
-/// The report's fixed part: version and garment counts.
+/// The report's fixed part: garment counts.
 nlohmann::json garment_summary(const Garment& g);
 
 inline constexpr const char* kVersion = "0.1.0";
