@@ -9,6 +9,7 @@ namespace refit {
 
 namespace {
 constexpr std::size_t kGrain = 1024;
+constexpr std::size_t kFirstQuery = 8;
 
 // Eq. 4's weight; |(u, v, w)| = |p - c| because the frame is orthonormal.
 inline double blend_weight(const Vec3& d) {
@@ -41,10 +42,13 @@ WarpBinding ReferenceBody::bind(const Points& points) const {
     std::vector<double> d2;
     for (std::size_t i = begin; i < end; ++i) {
       const Vec3 p = row3(points, static_cast<Index>(i));
-      tree_.knn(p, k, idx, d2);
+      // Near the body the eq. 2 set is small: a cheap query for a few centres
+      // usually holds all of it; only when it does not, ask for the cap.
+      tree_.knn(p, std::min(k, kFirstQuery), idx, d2);
       // Eq. 2: centres strictly within (1+alpha)|pq| of p; the nearest always counts
       // (a point exactly on a centre has |pq| = 0).
       const double r2 = d2[0] * scale2;
+      if (k > kFirstQuery && idx.size() == kFirstQuery && d2.back() < r2) tree_.knn(p, k, idx, d2);
       std::size_t m = 1;
       while (m < idx.size() && d2[m] < r2) ++m;
       std::copy_n(idx.begin(), m, slots.begin() + static_cast<std::ptrdiff_t>(i * k));

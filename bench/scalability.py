@@ -1,0 +1,67 @@
+#!/usr/bin/env python3
+"""End-to-end scalability driver: runs `refit resize` (load to write) on procedural
+dresses of several sizes with 1 and 2 threads and prints a Markdown table of the
+report's stage timings (ms) and peak memory, median of --repeat runs.
+
+    python3 bench/scalability.py [--refit build/release/tools/refit]
+        [--sizes 100000 1000000 4000000] [--threads 1 2] [--stage warp|full] [--repeat 3]
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+
+
+def run(cmd):
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--refit", default="build/release/tools/refit")
+    ap.add_argument("--sizes", type=int, nargs="+", default=[100000, 1000000, 4000000])
+    ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
+    ap.add_argument("--stage", default="full")
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--workdir", default=None)
+    a = ap.parse_args()
+    work = a.workdir or tempfile.mkdtemp(prefix="refit-scal-")
+    os.makedirs(work, exist_ok=True)
+    A, B = os.path.join(work, "A.obj"), os.path.join(work, "B.obj")
+    run([a.refit, "generate", "--body-out", A])
+    run([a.refit, "generate", "--belly", "6", "--hip", "104", "--waist", "76", "--bust", "92", "--body-out", B])
+    stages = ["load", "bind", "warp", "features", "surface", "write", "total"]
+    print(f"stage: {a.stage}; medians of {a.repeat} runs; ms except memory")
+    print("| vertices | threads | " + " | ".join(stages) + " | peak MB | bytes/vertex |")
+    print("|" + "---:|" * (len(stages) + 4))
+    for n in a.sizes:
+        g = os.path.join(work, f"dress_{n}.obj")
+        f = os.path.join(work, f"dress_{n}.json")
+        run([a.refit, "generate", "--vertices", str(n), "--garment-out", g, "--features-out", f])
+        for t in a.threads:
+            rows = []
+            for _ in range(a.repeat):
+                rep = os.path.join(work, "report.json")
+                cmd = [a.refit, "resize", "--garment", g, "--from", A, "--to", B, "--out", os.path.join(work, "out.obj"),
+                       "--report", rep, "--threads", str(t), "--quiet", "--stage", a.stage]
+                if a.stage != "warp":
+                    cmd += ["--features", f]
+                run(cmd)
+                rows.append(json.load(open(rep)))
+            def med(key):
+                vals = []
+                for r in rows:
+                    v = r["timings_ms"].get(key, 0.0)
+                    vals.append(sum(v.values()) if isinstance(v, dict) else v)
+                return statistics.median(vals)
+            verts = rows[0]["garment"]["vertices"]
+            mem = statistics.median(r["peak_memory_mb"] for r in rows)
+            cells = " | ".join(f"{med(s):.0f}" for s in stages)
+            print(f"| {verts} | {t} | {cells} | {mem:.0f} | {mem * 1048576 / verts:.0f} |", flush=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
