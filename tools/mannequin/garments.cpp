@@ -608,7 +608,13 @@ std::string dress_features_json(const BodyParams& body, const GarmentParams& g) 
   const BodyShape shape(body);
   const DressPlan d(shape, g.ease);
   const double y_mid = 0.5 * (d.y_w + d.y_h);
+  // The hem comes first: curves are processed in file order and a later curve
+  // keeps its crossings where an earlier one put them, so each profile is then
+  // held at both ends (the hem below, the body at the waist), which fixes its
+  // scale; the other order lets four profiles pull the hem apart.
   std::string out = "{\n  \"units\": \"cm\",\n  \"features\": [\n";
+  out += "    { \"name\": \"hem\", \"curve\": { \"kind\": \"boundary\", \"near\": " +
+         fmt3(Vec3(0, d.y_h, d.r(d.y_h, 0, 1))) + " }, \"samples\": 120 },\n";
   struct Side {
     const char* name;
     double c, s;
@@ -624,10 +630,9 @@ std::string dress_features_json(const BodyParams& body, const GarmentParams& g) 
     out += "    { \"name\": \"" + std::string(sd.name) + "\", \"plane\": { \"point\": " + fmt3(Vec3(0, y_mid, 0)) +
            ", \"normal\": " + fmt3(normal) + " },\n      \"curve\": { \"kind\": \"slice\", \"near\": " + fmt3(at(y_mid)) +
            ", \"from\": " + fmt3(at(d.y_w)) + ", \"to\": " + fmt3(at(d.y_h)) +
-           ", \"control_points\": 12 }, \"samples\": 80 },\n";
+           ", \"control_points\": 12 }, \"samples\": 80 }" + (&sd == &sides[3] ? "\n" : ",\n");
   }
-  out += "    { \"name\": \"hem\", \"curve\": { \"kind\": \"boundary\", \"near\": " +
-         fmt3(Vec3(0, d.y_h, d.r(d.y_h, 0, 1))) + " }, \"samples\": 120 }\n  ]\n}\n";
+  out += "  ]\n}\n";
   return out;
 }
 
