@@ -1,0 +1,176 @@
+// The command line is a contract scripts depend on: outputs, reports, exit
+// codes, and bad input that leaves nothing behind.
+#include "mannequin/mannequin.hpp"
+#include "support/test_support.hpp"
+
+#include <refit/io/body_io.hpp>
+#include <refit/io/obj_garment.hpp>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+namespace refit {
+namespace {
+
+namespace fs = std::filesystem;
+using test::run_cli;
+
+// A small procedural case written to files: bodies A and B (belly, hips), a dress
+// and its feature file.
+struct Case {
+  test::TempDir dir;
+  std::string a, b, garment, features;
+  Case(std::size_t vertices = 6000) {
+    mannequin::BodyParams pa, pb;
+    pb.belly = 6;
+    pb.hip = 104;
+    mannequin::GarmentParams g;
+    g.target_vertices = vertices;
+    a = dir.file("A.obj");
+    b = dir.file("B.obj");
+    garment = dir.file("dress.obj");
+    features = dir.file("features.json");
+    write_body_obj(a, mannequin::make_body(pa));
+    write_body_obj(b, mannequin::make_body(pb));
+    write_garment_obj(garment, mannequin::make_garment(pa, g));
+    test::write_text(features, mannequin::dress_features_json(pa, g));
+  }
+  std::string resize(const std::string& out, const std::string& extra = "") const {
+    return "resize --quiet --garment '" + garment + "' --from '" + a + "' --to '" + b + "' --out '" + out + "' " + extra;
+  }
+};
+
+// Only the named outputs may exist in the folder: no partial or temporary files.
+std::vector<std::string> files_in(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+TEST(Cli, ResizeWritesOutputAndReport) {
+  const Case c;
+  const std::string out = c.dir.file("out.obj"), rep = c.dir.file("r.json");
+  const auto r = run_cli(c.resize(out, "--features '" + c.features + "' --report '" + rep + "'"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Garment g = read_garment_obj(out);
+  EXPECT_EQ(g.vertex_count(), read_garment_obj(c.garment).vertex_count());
+  const auto j = nlohmann::json::parse(test::read_text(rep));
+  for (const char* key : {"version", "garment", "timings_ms", "peak_memory_mb", "warnings", "features", "surface"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  for (const char* key : {"vertices", "faces", "lines", "points"}) EXPECT_TRUE(j["garment"].contains(key)) << key;
+  for (const char* key : {"load", "warp", "write", "total", "features", "surface"})
+    EXPECT_TRUE(j["timings_ms"].contains(key)) << key;
+  EXPECT_EQ(j["features"].size(), 5u);
+  for (const char* key : {"agents", "voxel", "fixed_body", "fixed_feature", "anchored", "iterations", "final_update"})
+    EXPECT_TRUE(j["surface"].contains(key)) << key;
+}
+
+TEST(Cli, OneAndTwoThreadsWriteIdenticalBytes) {
+  const Case c;
+  const std::string one = c.dir.file("one.obj"), two = c.dir.file("two.obj");
+  const std::string feats = "--features '" + c.features + "' ";
+  ASSERT_EQ(run_cli(c.resize(one, feats + "--threads 1")).exit_code, 0);
+  ASSERT_EQ(run_cli(c.resize(two, feats + "--threads 2")).exit_code, 0);
+  EXPECT_EQ(test::read_text(one), test::read_text(two));
+}
+
+TEST(Cli, SameBodyGivesTheSameGarment) {
+  const Case c;
+  const std::string out = c.dir.file("out.obj");
+  const auto r = run_cli("resize --quiet --no-collision --garment '" + c.garment + "' --from '" + c.a + "' --to '" + c.a +
+                         "' --out '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Garment in = read_garment_obj(c.garment), res = read_garment_obj(out);
+  EXPECT_LE((res.positions - in.positions).cwiseAbs().maxCoeff(), 1e-6 * in.positions.cwiseAbs().maxCoeff());
+}
+
+TEST(Cli, ManyBodiesSkipTheBadOneAndWriteTheOthers) {
+  const Case c;
+  const std::string bad = c.dir.file("bad.obj");
+  test::write_text(bad, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const std::string dir = c.dir.file("out");
+  const auto r = run_cli("resize --quiet --stage warp --garment '" + c.garment + "' --from '" + c.a + "' --to '" + c.b +
+                         "' '" + bad + "' '" + c.a + "' --out-dir '" + dir + "' --report '" + c.dir.file("r.json") + "'");
+  EXPECT_EQ(r.exit_code, 4);
+  EXPECT_NE(r.err.find("bad.obj"), std::string::npos) << r.err;
+  EXPECT_EQ(files_in(dir), (std::vector<std::string>{"A.obj", "B.obj"}));
+  const auto j = nlohmann::json::parse(test::read_text(c.dir.file("r.json")));
+  EXPECT_EQ(j["bodies"].size(), 3u);
+}
+
+struct BadInput {
+  std::string name, file_text, which, expect;  // which: garment, from, to, features
+};
+
+class CliBadInput : public ::testing::TestWithParam<BadInput> {};
+
+TEST_P(CliBadInput, OneClearLineNonZeroExitNoOutput) {
+  const BadInput& p = GetParam();
+  const Case c(2000);
+  std::string garment = c.garment, from = c.a, to = c.b, features = c.features;
+  const std::string bad = c.dir.file("bad_" + p.which + (p.which == "features" ? ".json" : ".obj"));
+  if (p.file_text != "<missing>") test::write_text(bad, p.file_text);
+  (p.which == "garment" ? garment : p.which == "from" ? from : p.which == "to" ? to : features) = bad;
+  const fs::path out_dir = c.dir.path() / "out";
+  fs::create_directories(out_dir);
+  const std::string out = (out_dir / "out.obj").string();
+  const auto r = run_cli("resize --quiet --garment '" + garment + "' --from '" + from + "' --to '" + to + "' --features '" +
+                         features + "' --out '" + out + "' --report '" + (out_dir / "r.json").string() + "'");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find(bad), std::string::npos) << "message must name the file: " << r.err;
+  EXPECT_NE(r.err.find(p.expect), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line: " << r.err;
+  EXPECT_TRUE(files_in(out_dir).empty()) << "no output may be left behind";
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, CliBadInput,
+    ::testing::Values(
+        BadInput{"missing_garment", "<missing>", "garment", "cannot"},
+        BadInput{"malformed_line", "v 0 0 0\nv 1 0 0\nv 0 1 zero\nf 1 2 3\n", "garment", ":3:"},
+        BadInput{"index_out_of_range", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", "garment", ":4:"},
+        BadInput{"nan_vertex", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n", "garment", ":2:"},
+        BadInput{"inf_vertex", "v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n", "garment", ":3:"},
+        BadInput{"empty_garment", "# nothing here\n", "garment", "empty"},
+        BadInput{"body_other_connectivity", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "to", "correspond"},
+        BadInput{"body_malformed", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n", "from", ":4:"},
+        BadInput{"features_not_json", "{ \"features\": [ ", "features", "bad_features.json"},
+        BadInput{"features_unknown_kind",
+                 R"({"units":"cm","features":[{"name":"x","plane":{"point":[0,0,0],"normal":[0,0,1]},"curve":{"kind":"spiral"},"samples":20}]})",
+                 "features", "spiral"},
+        BadInput{"features_miss_garment",
+                 R"({"units":"cm","features":[{"name":"far","plane":{"point":[0,0,5000],"normal":[0,0,1]},"curve":{"kind":"slice","near":[0,0,5000]},"samples":20}]})",
+                 "features", "far"}),
+    [](const auto& info) { return info.param.name; });
+
+TEST(Cli, InspectCountsTheSoup) {
+  test::TempDir dir;
+  mannequin::GarmentParams g;
+  g.target_vertices = 3000;
+  g.soup = true;
+  const std::string path = dir.file("soup.obj");
+  write_garment_obj(path, mannequin::make_garment({}, g));
+  const auto r = run_cli("inspect '" + path + "' --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_GT(j["non_manifold_edges"].get<int>(), 0);
+  EXPECT_EQ(j["unreferenced_vertices"].get<int>(), 1);
+  EXPECT_EQ(j["lines"].get<int>(), 2);
+}
+
+TEST(Cli, DemoWritesItsFiles) {
+  test::TempDir dir;
+  const auto r = run_cli("demo --quiet --vertices 4000 --out-dir '" + dir.file("demo") + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* f : {"body_A.obj", "body_B.obj", "dress_on_A.obj", "dress_features.json", "dress_on_B.obj",
+                        "dress_on_B_warp_only.obj", "dress_curves.obj", "report.json"})
+    EXPECT_TRUE(fs::exists(dir.path() / "demo" / f)) << f;
+  EXPECT_NE(r.out.find("demo output") == std::string::npos ? r.out.find("output:") : 0, std::string::npos);
+}
+
+}  // namespace
+}  // namespace refit
