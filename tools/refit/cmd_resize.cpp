@@ -20,7 +20,7 @@ struct ResizeArgs {
   std::string garment, from, out, out_dir, report, features, curves_out, units = "cm", stage = "full";
   std::vector<std::string> to;
   std::size_t threads = 0, max_triangles = WarpOptions{}.max_triangles;
-  bool quiet = false, no_shape_control = false, no_collision = false, encode_on_warped = false;
+  bool quiet = false, paper_closeness = false, no_shape_control = false, no_collision = false, encode_on_warped = false;
   SurfaceOptions surface;
   double clearance = 0.2;
 };
@@ -44,6 +44,7 @@ int run(const ResizeArgs& a) {
   options.stage = parse_stage(a.stage);
   options.warp.max_triangles = a.max_triangles;
   options.surface = a.surface;
+  options.shape_matching.sampling_invariant = !a.paper_closeness;
   options.surface.encode_on_warped = a.encode_on_warped;
   options.collision = !a.no_collision;
   options.clearance_cm = a.clearance;
@@ -131,6 +132,8 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
   app.add_option("--max-triangles", a->max_triangles, "Cap on the warp's triangle set per vertex")->capture_default_str();
   app.add_option("--features", a->features, "Feature curves (JSON) whose shape must survive");
   app.add_option("--curves-out", a->curves_out, "Write original, warped and optimised feature curves (OBJ l lines)");
+  app.add_flag("--paper-closeness", a->paper_closeness,
+               "Feature closeness term as the paper's plain sums (weak: keeps most of the warp's bend)");
   app.add_flag("--no-shape-control", a->no_shape_control, "The warp alone (same as --stage warp)");
   app.add_option("--voxel", a->surface.voxel, "Agent voxel size in cm (0 = from the garment size and --agents)")
       ->capture_default_str();

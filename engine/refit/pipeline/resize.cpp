@@ -123,7 +123,7 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
   if (!features.empty()) {
     clock.reset();
     progress.stage("sampling " + std::to_string(features.size()) + " feature curves");
-    features_ = bind_features(body_a_, build_feature_curves(*garment_, features));
+    features_ = bind_features(body_a_, build_feature_curves(*garment_, features), options_.shape_matching);
     bind_report_["features"] = clock.ms();
   }
   if (options_.stage == Stage::Full) {

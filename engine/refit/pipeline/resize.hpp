@@ -27,6 +27,7 @@ struct ResizeOptions {
   std::string units = "cm";    // garment units; physical constants below are in cm
   Stage stage = Stage::Full;
   WarpOptions warp;
+  ShapeMatchingOptions shape_matching;
   SurfaceOptions surface;      // epsilon and voxel in cm here; converted to garment units
   bool collision = true;       // push vertices inside body B out (beyond the paper)
   double clearance_cm = 0.2;   // ... to this distance outside the body
