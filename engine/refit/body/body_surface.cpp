@@ -1,0 +1,526 @@
+// Body surface queries through Embree 3. Embree (float) only finds candidate
+// triangles and ray hits; every distance and every inside/outside decision near
+// the surface is made in double on the body's own positions.
+#include <refit/body/body_surface.hpp>
+#include <refit/core/error.hpp>
+
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace refit {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Where on a triangle the closest point lies: the face, one of its corners, or
+// one of its edges (edge k runs from corner k to corner k+1).
+enum Region : int { kFace = 0, kVertex0 = 1, kEdge0 = 4 };
+
+struct TrianglePoint {
+  Vec3 point;
+  int region;
+};
+
+// Closest point on triangle abc to p (Ericson, Real-Time Collision Detection 5.1.5),
+// in double, also telling which feature (face, edge, vertex) it lies on.
+TrianglePoint closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return {a, kVertex0 + 0};
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0.0 && d4 <= d3) return {b, kVertex0 + 1};
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return {a + (d1 / (d1 - d3)) * ab, kEdge0 + 0};
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0.0 && d5 <= d6) return {c, kVertex0 + 2};
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return {a + (d2 / (d2 - d6)) * ac, kEdge0 + 2};
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0)
+    return {b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b), kEdge0 + 1};
+  const double denom = 1.0 / (va + vb + vc);
+  return {a + ab * (vb * denom) + ac * (vc * denom), kFace};
+}
+
+// Fixed, irrational-looking ray directions so that rays rarely run along mesh
+// edges or axis-aligned features.
+const std::array<Vec3, 5>& ray_directions() {
+  static const std::array<Vec3, 5> dirs = [] {
+    std::array<Vec3, 5> d = {Vec3(0.5773, 0.6183, 0.5332), Vec3(-0.7071, 0.1234, 0.6963),
+                             Vec3(0.2113, -0.9127, 0.3498), Vec3(-0.3761, -0.4193, -0.8263),
+                             Vec3(0.8614, 0.0957, -0.4989)};
+    for (auto& v : d) v.normalize();
+    return d;
+  }();
+  return dirs;
+}
+
+struct RayHit {
+  float t;
+  Index tri;
+  int side;  // +1 leaving (along the face normal), -1 entering, 0 grazing
+};
+
+constexpr int kMaxHits = 256;
+
+// Intersect context extended with a hit list: the context filter records every
+// hit along the ray and rejects it, so Embree reports all crossings, not only
+// the first.
+struct CollectContext {
+  RTCIntersectContext ctx;
+  const Points* face_normal = nullptr;
+  Vec3 dir = Vec3::Zero();
+  std::array<RayHit, kMaxHits> hits;
+  int count = 0;
+  bool overflow = false;
+};
+
+void collect_filter(const RTCFilterFunctionNArguments* args) {
+  auto* c = reinterpret_cast<CollectContext*>(args->context);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) continue;
+    args->valid[i] = 0;  // reject, so traversal goes on to the next hit
+    if (c->count >= kMaxHits) {
+      c->overflow = true;
+      continue;
+    }
+    const Index tri = RTCHitN_primID(args->hit, args->N, i);
+    const double s = c->face_normal->row(tri).dot(c->dir);
+    c->hits[static_cast<std::size_t>(c->count++)] = {RTCRayN_tfar(args->ray, args->N, i), tri,
+                                                     s > 0.0 ? 1 : (s < 0.0 ? -1 : 0)};
+  }
+}
+
+struct PointQueryData {
+  const Points* vertices;
+  const std::vector<std::array<Index, 3>>* triangles;
+  const std::vector<std::uint8_t>* degenerate;
+  Vec3 p;
+  double best_d2 = kInf;
+  Index tri = 0;
+  Vec3 point = Vec3::Zero();
+  int region = 0;
+};
+
+bool point_query_callback(RTCPointQueryFunctionArguments* args) {
+  auto* d = static_cast<PointQueryData*>(args->userPtr);
+  const Index t = args->primID;
+  if ((*d->degenerate)[t]) return false;  // its points lie on neighbours' edges anyway
+  const auto& tri = (*d->triangles)[t];
+  const TrianglePoint tp = closest_on_triangle(d->p, row3(*d->vertices, tri[0]), row3(*d->vertices, tri[1]),
+                                               row3(*d->vertices, tri[2]));
+  const double d2 = (tp.point - d->p).squaredNorm();
+  if (d2 < d->best_d2 || (d2 == d->best_d2 && t < d->tri)) {  // ties: lowest index, for determinism
+    d->best_d2 = d2;
+    d->tri = t;
+    d->point = tp.point;
+    d->region = tp.region;
+    // Slightly larger than the double distance so float rounding never culls
+    // an equally close triangle.
+    args->query->radius = static_cast<float>(std::sqrt(d2) * (1.0 + 1e-6)) + 1e-30f;
+    return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+struct BodySurface::Impl {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  Points vertices;
+  std::vector<std::array<Index, 3>> triangles;
+  Points face_normal;                     // unit, zero for degenerate triangles
+  std::vector<std::uint8_t> degenerate;
+  Points edge_normal;                     // row 3t+k: sum of the normals of the faces on edge k of t
+  std::vector<std::uint8_t> edge_ok;      // edge has exactly two faces with opposite edge directions
+  Points vertex_normal;                   // angle-weighted pseudonormal
+  std::vector<std::uint8_t> vertex_ok;    // every edge around the vertex is ok
+  bool oriented = false;                  // closed, manifold, consistently oriented
+  double orientation = 1.0;               // +1 when normals point outward (positive volume)
+  double near_tolerance = 0.0;            // below this distance the pseudonormal decides inside
+  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();  // body bounding box
+  // Inside/outside grid, built on the first inside test: cells that touch no
+  // triangle's bounding box get the label of their connected region (one ray
+  // vote per region), so most points far from the surface need no ray at all.
+  enum : std::uint8_t { kBoundary = 0, kOutside = 1, kInside = 2 };
+  mutable std::once_flag grid_once;
+  mutable std::vector<std::uint8_t> grid;
+  mutable Vec3 grid_lo = Vec3::Zero();
+  mutable double grid_h = 1.0;
+  mutable std::array<long, 3> grid_n = {0, 0, 0};
+  double tie_tolerance = 0.0;             // hits closer than this along a ray are one crossing
+
+  ~Impl() {
+    if (scene) rtcReleaseScene(scene);
+    if (device) rtcReleaseDevice(device);
+  }
+
+  PointQueryData query(const Vec3& p, double max_distance) const {
+    PointQueryData d{&vertices, &triangles, &degenerate, p};
+    RTCPointQuery q;
+    q.x = static_cast<float>(p.x());
+    q.y = static_cast<float>(p.y());
+    q.z = static_cast<float>(p.z());
+    q.time = 0.0f;
+    q.radius = std::isfinite(max_distance) ? static_cast<float>(max_distance * (1.0 + 1e-6)) + 1e-30f
+                                           : std::numeric_limits<float>::infinity();
+    RTCPointQueryContext ctx;
+    rtcInitPointQueryContext(&ctx);
+    rtcPointQuery(scene, &q, &ctx, point_query_callback, &d);
+    if (d.best_d2 > max_distance * max_distance) d.best_d2 = kInf;
+    return d;
+  }
+
+  // Inside decision from the closest feature (Baerentzen and Aanaes' angle-weighted
+  // pseudonormal): exact in double for a closed, manifold, oriented mesh.
+  // Returns -1 when the feature cannot decide (non-manifold or unoriented).
+  int inside_by_pseudonormal(const PointQueryData& d) const {
+    if (!oriented || !std::isfinite(d.best_d2)) return -1;
+    Vec3 n;
+    if (d.region == kFace) {
+      n = row3(face_normal, d.tri);
+    } else if (d.region >= kEdge0) {
+      const Index e = 3 * d.tri + static_cast<Index>(d.region - kEdge0);
+      if (!edge_ok[e]) return -1;
+      n = row3(edge_normal, e);
+    } else {
+      const Index v = triangles[d.tri][static_cast<std::size_t>(d.region - kVertex0)];
+      if (!vertex_ok[v]) return -1;
+      n = row3(vertex_normal, v);
+    }
+    const double s = (d.p - d.point).dot(n) * orientation;
+    return s < 0.0 ? 1 : 0;
+  }
+
+  // Crossing count along one ray: hits within tie_tolerance of each other are one
+  // crossing place (a shared edge or vertex); its net side (+1, 0 or -1) is what
+  // counts, so a ray grazing a silhouette edge adds nothing. Returns the winding
+  // number (oriented bodies) or the parity (others); -1 when the ray is unusable.
+  int ray_vote(const Vec3& p, const Vec3& dir) const {
+    CollectContext c;
+    rtcInitIntersectContext(&c.ctx);
+    c.ctx.filter = collect_filter;
+    c.face_normal = &face_normal;
+    c.dir = dir;
+    RTCRayHit rh;
+    rh.ray.org_x = static_cast<float>(p.x());
+    rh.ray.org_y = static_cast<float>(p.y());
+    rh.ray.org_z = static_cast<float>(p.z());
+    rh.ray.dir_x = static_cast<float>(dir.x());
+    rh.ray.dir_y = static_cast<float>(dir.y());
+    rh.ray.dir_z = static_cast<float>(dir.z());
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = std::numeric_limits<float>::infinity();
+    rh.ray.time = 0.0f;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(scene, &c.ctx, &rh);
+    if (c.overflow) return -1;
+    std::sort(c.hits.begin(), c.hits.begin() + c.count, [](const RayHit& a, const RayHit& b) {
+      return a.t < b.t || (a.t == b.t && a.tri < b.tri);
+    });
+    int winding = 0, crossings = 0;
+    for (int i = 0; i < c.count;) {
+      int j = i, net = 0;
+      Index last_tri = RTC_INVALID_GEOMETRY_ID;
+      while (j < c.count && c.hits[static_cast<std::size_t>(j)].t - c.hits[static_cast<std::size_t>(i)].t <=
+                                static_cast<float>(tie_tolerance)) {
+        const RayHit& h = c.hits[static_cast<std::size_t>(j)];
+        if (h.tri != last_tri) net += h.side;  // a triangle reported twice counts once
+        last_tri = h.tri;
+        ++j;
+      }
+      const int side = net > 0 ? 1 : (net < 0 ? -1 : 0);
+      winding += side;
+      crossings += side != 0 ? 1 : 0;
+      i = j;
+    }
+    if (oriented) return winding * static_cast<int>(orientation) > 0 ? 1 : 0;
+    return crossings & 1;
+  }
+
+  bool inside_by_rays(const Vec3& p) const {
+    int yes = 0, no = 0;
+    for (const Vec3& dir : ray_directions()) {
+      const int v = ray_vote(p, dir);
+      if (v == 1) ++yes;
+      if (v == 0) ++no;
+      if (yes >= 3 || no >= 3) break;  // majority of five reached
+    }
+    return yes > no;
+  }
+
+  long cell_index(long x, long y, long z) const { return (z * grid_n[1] + y) * grid_n[0] + x; }
+
+  void build_grid() const {
+    // About half the near tolerance per cell, so a point in a boundary cell is
+    // usually within the tolerance and decided by the pseudonormal; capped at
+    // about 4M cells.
+    const Vec3 ext = hi - lo;
+    grid_h = std::max(0.5 * near_tolerance, std::cbrt(ext.prod() / 4.0e6));
+    grid_lo = lo - Vec3::Constant(2.0 * grid_h);
+    for (int k = 0; k < 3; ++k) grid_n[static_cast<std::size_t>(k)] = static_cast<long>(std::ceil(ext[k] / grid_h)) + 4;
+    grid.assign(static_cast<std::size_t>(grid_n[0] * grid_n[1] * grid_n[2]), 255);
+    auto cell_of = [&](double v, int k) {
+      return std::clamp(static_cast<long>(std::floor((v - grid_lo[k]) / grid_h)), 0L, grid_n[static_cast<std::size_t>(k)] - 1);
+    };
+    const double pad = 1e-9 * (hi - lo).norm();
+    for (const auto& tri : triangles) {
+      Vec3 tlo = row3(vertices, tri[0]), thi = tlo;
+      for (int k = 1; k < 3; ++k) {
+        tlo = tlo.cwiseMin(row3(vertices, tri[static_cast<std::size_t>(k)]));
+        thi = thi.cwiseMax(row3(vertices, tri[static_cast<std::size_t>(k)]));
+      }
+      for (long z = cell_of(tlo.z() - pad, 2); z <= cell_of(thi.z() + pad, 2); ++z)
+        for (long y = cell_of(tlo.y() - pad, 1); y <= cell_of(thi.y() + pad, 1); ++y)
+          for (long x = cell_of(tlo.x() - pad, 0); x <= cell_of(thi.x() + pad, 0); ++x)
+            grid[static_cast<std::size_t>(cell_index(x, y, z))] = kBoundary;
+    }
+    // Flood fill each region of free cells (6-connected); a region touches no
+    // triangle, so one vote at any of its cells is the answer for all of them.
+    std::vector<long> queue;
+    for (long start = 0; start < static_cast<long>(grid.size()); ++start) {
+      if (grid[static_cast<std::size_t>(start)] != 255) continue;
+      const long sx = start % grid_n[0], sy = (start / grid_n[0]) % grid_n[1], sz = start / (grid_n[0] * grid_n[1]);
+      const Vec3 centre = grid_lo + grid_h * Vec3(sx + 0.5, sy + 0.5, sz + 0.5);
+      const std::uint8_t label = inside_by_rays(centre) ? kInside : kOutside;
+      queue.assign(1, start);
+      grid[static_cast<std::size_t>(start)] = label;
+      while (!queue.empty()) {
+        const long c = queue.back();
+        queue.pop_back();
+        const long x = c % grid_n[0], y = (c / grid_n[0]) % grid_n[1], z = c / (grid_n[0] * grid_n[1]);
+        const long nb[6][3] = {{x - 1, y, z}, {x + 1, y, z}, {x, y - 1, z}, {x, y + 1, z}, {x, y, z - 1}, {x, y, z + 1}};
+        for (const auto& q : nb) {
+          if (q[0] < 0 || q[1] < 0 || q[2] < 0 || q[0] >= grid_n[0] || q[1] >= grid_n[1] || q[2] >= grid_n[2]) continue;
+          const long qi = cell_index(q[0], q[1], q[2]);
+          if (grid[static_cast<std::size_t>(qi)] != 255) continue;
+          grid[static_cast<std::size_t>(qi)] = label;
+          queue.push_back(qi);
+        }
+      }
+    }
+  }
+
+  // kInside / kOutside when the grid knows, kBoundary when the point needs a query.
+  std::uint8_t grid_label(const Vec3& p) const {
+    std::call_once(grid_once, [this] { build_grid(); });
+    long c[3];
+    for (int k = 0; k < 3; ++k) {
+      const double f = std::floor((p[k] - grid_lo[k]) / grid_h);
+      if (f < 0.0 || f >= static_cast<double>(grid_n[static_cast<std::size_t>(k)])) return kOutside;  // beyond the box
+      c[k] = static_cast<long>(f);
+    }
+    return grid[static_cast<std::size_t>(cell_index(c[0], c[1], c[2]))];
+  }
+
+  bool inside_given(const PointQueryData& d) const {
+    if (d.best_d2 == 0.0) return false;  // on the surface is not inside
+    if (d.best_d2 <= near_tolerance * near_tolerance) {
+      const int s = inside_by_pseudonormal(d);
+      if (s >= 0) return s == 1;
+    }
+    const std::uint8_t g = grid_label(d.p);
+    if (g != kBoundary) return g == kInside;
+    return inside_by_rays(d.p);
+  }
+};
+
+BodySurface::BodySurface(const BodyMesh& body) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  const std::string file = body.path.empty() ? (body.name.empty() ? std::string("<body>") : body.name) : body.path;
+  const Index nv = static_cast<Index>(body.vertices.rows());
+  const Index nt = static_cast<Index>(body.triangles.size());
+  if (nt == 0) throw input_error(file, "body has no triangles");
+  if (!body.vertices.allFinite()) throw input_error(file, "body has a NaN or infinite vertex");
+  for (Index t = 0; t < nt; ++t)
+    for (Index c : body.triangles[t])
+      if (c >= nv)
+        throw input_error(file, "triangle " + std::to_string(t + 1) + " uses vertex " + std::to_string(c + 1) +
+                                    " but the body has " + std::to_string(nv) + " vertices");
+  m.vertices = body.vertices;
+  m.triangles = body.triangles;
+
+  // Face normals, degenerate triangles, bounding box, signed volume.
+  m.face_normal.setZero(nt, 3);
+  m.degenerate.assign(nt, 0);
+  double volume = 0.0;
+  for (Index t = 0; t < nt; ++t) {
+    const auto& tri = m.triangles[t];
+    const Vec3 a = row3(m.vertices, tri[0]), b = row3(m.vertices, tri[1]), c = row3(m.vertices, tri[2]);
+    const Vec3 n = (b - a).cross(c - a);
+    const double len = n.norm();
+    const double scale2 = std::max({(b - a).squaredNorm(), (c - a).squaredNorm(), (c - b).squaredNorm()});
+    if (!(len > 1e-14 * scale2)) {
+      m.degenerate[t] = 1;
+    } else {
+      m.face_normal.row(t) = (n / len).transpose();
+    }
+    volume += a.dot(b.cross(c)) / 6.0;
+  }
+  m.lo = m.vertices.colwise().minCoeff().transpose();
+  m.hi = m.vertices.colwise().maxCoeff().transpose();
+  const double diag = std::max((m.hi - m.lo).norm(), 1e-300);
+  // Within 0.5% of the body's size (about 1 cm on an adult) the closest
+  // feature's pseudonormal decides inside; farther out the grid or the rays do,
+  // which also stay right where the body intersects itself.
+  m.near_tolerance = 5e-3 * diag;
+  m.tie_tolerance = 1e-6 * diag;
+
+  // Edge incidence: sort directed edges by undirected key; a good edge has exactly
+  // two faces traversing it in opposite directions.
+  struct DirEdge {
+    std::uint64_t key;
+    Index slot;  // 3t + k
+    bool forward;
+  };
+  std::vector<DirEdge> edges;
+  edges.reserve(3 * static_cast<std::size_t>(nt));
+  for (Index t = 0; t < nt; ++t)
+    for (Index k = 0; k < 3; ++k) {
+      const Index a = m.triangles[t][k], b = m.triangles[t][(k + 1) % 3];
+      const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
+      edges.push_back({key, 3 * t + k, a < b});
+    }
+  std::sort(edges.begin(), edges.end(), [](const DirEdge& x, const DirEdge& y) {
+    return x.key < y.key || (x.key == y.key && x.slot < y.slot);
+  });
+  m.edge_normal.setZero(3 * static_cast<Eigen::Index>(nt), 3);
+  m.edge_ok.assign(3 * static_cast<std::size_t>(nt), 0);
+  m.vertex_ok.assign(nv, 1);
+  bool all_ok = true;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j].key == edges[i].key) ++j;
+    const bool ok = (j - i == 2) && edges[i].forward != edges[i + 1].forward;
+    Vec3 n = Vec3::Zero();
+    for (std::size_t e = i; e < j; ++e) n += row3(m.face_normal, edges[e].slot / 3);
+    for (std::size_t e = i; e < j; ++e) {
+      m.edge_normal.row(edges[e].slot) = n.transpose();
+      m.edge_ok[edges[e].slot] = ok ? 1 : 0;
+    }
+    if (!ok) {
+      all_ok = false;
+      m.vertex_ok[static_cast<Index>(edges[i].key >> 32)] = 0;
+      m.vertex_ok[static_cast<Index>(edges[i].key & 0xFFFFFFFFu)] = 0;
+    }
+    i = j;
+  }
+  m.oriented = all_ok;
+  m.orientation = volume < 0.0 ? -1.0 : 1.0;
+
+  // Angle-weighted vertex pseudonormals.
+  m.vertex_normal.setZero(nv, 3);
+  for (Index t = 0; t < nt; ++t) {
+    if (m.degenerate[t]) continue;
+    const auto& tri = m.triangles[t];
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 p = row3(m.vertices, tri[k]);
+      const Vec3 e1 = (row3(m.vertices, tri[(k + 1) % 3]) - p).normalized();
+      const Vec3 e2 = (row3(m.vertices, tri[(k + 2) % 3]) - p).normalized();
+      const double angle = std::acos(std::clamp(e1.dot(e2), -1.0, 1.0));
+      m.vertex_normal.row(tri[k]) += angle * m.face_normal.row(t);
+    }
+  }
+
+  // Embree scene: float copies in Embree-owned (padded) buffers.
+  m.device = rtcNewDevice(nullptr);
+  if (!m.device) throw Error("Embree: cannot create a device");
+  m.scene = rtcNewScene(m.device);
+  rtcSetSceneFlags(m.scene, static_cast<RTCSceneFlags>(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION));
+  rtcSetSceneBuildQuality(m.scene, RTC_BUILD_QUALITY_MEDIUM);
+  RTCGeometry geom = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* vb = static_cast<float*>(
+      rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv));
+  auto* ib = static_cast<unsigned*>(
+      rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nt));
+  if (!vb || !ib) {
+    rtcReleaseGeometry(geom);
+    throw Error("Embree: cannot allocate the body buffers for " + file);
+  }
+  for (Index i = 0; i < nv; ++i)
+    for (int k = 0; k < 3; ++k) vb[3 * i + static_cast<Index>(k)] = static_cast<float>(m.vertices(i, k));
+  for (Index t = 0; t < nt; ++t)
+    for (Index k = 0; k < 3; ++k) ib[3 * t + k] = m.triangles[t][k];
+  rtcCommitGeometry(geom);
+  rtcAttachGeometry(m.scene, geom);
+  rtcReleaseGeometry(geom);
+  rtcCommitScene(m.scene);
+  if (rtcGetDeviceError(m.device) != RTC_ERROR_NONE) throw Error("Embree: building the scene of " + file + " failed");
+}
+
+BodySurface::~BodySurface() = default;
+BodySurface::BodySurface(BodySurface&&) noexcept = default;
+BodySurface& BodySurface::operator=(BodySurface&&) noexcept = default;
+
+ClosestPoint BodySurface::closest(const Vec3& p) const { return closest_within(p, kInf); }
+
+ClosestPoint BodySurface::closest_within(const Vec3& p, double max_distance) const {
+  const PointQueryData d = impl_->query(p, max_distance);
+  ClosestPoint r;
+  if (!std::isfinite(d.best_d2)) {
+    r.distance = kInf;
+    return r;
+  }
+  r.point = d.point;
+  r.normal = row3(impl_->face_normal, d.tri);
+  r.distance = std::sqrt(d.best_d2);
+  r.triangle = d.tri;
+  return r;
+}
+
+bool BodySurface::inside(const Vec3& p) const {
+  if (!p.allFinite()) return false;
+  const std::uint8_t g = impl_->grid_label(p);
+  if (g != Impl::kBoundary) return g == Impl::kInside;
+  // Only a nearby closest point is needed: farther points go to the rays anyway.
+  return impl_->inside_given(impl_->query(p, impl_->near_tolerance));
+}
+
+double BodySurface::signed_distance(const Vec3& p) const {
+  if (!p.allFinite()) return std::numeric_limits<double>::quiet_NaN();
+  const PointQueryData d = impl_->query(p, kInf);
+  const double dist = std::sqrt(d.best_d2);
+  return impl_->inside_given(d) ? -dist : dist;
+}
+
+double BodySurface::intersect(const Vec3& origin, const Vec3& dir, Index* tri_out) const {
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  RTCRayHit rh;
+  rh.ray.org_x = static_cast<float>(origin.x());
+  rh.ray.org_y = static_cast<float>(origin.y());
+  rh.ray.org_z = static_cast<float>(origin.z());
+  rh.ray.dir_x = static_cast<float>(dir.x());
+  rh.ray.dir_y = static_cast<float>(dir.y());
+  rh.ray.dir_z = static_cast<float>(dir.z());
+  rh.ray.tnear = 0.0f;
+  rh.ray.tfar = std::numeric_limits<float>::infinity();
+  rh.ray.time = 0.0f;
+  rh.ray.mask = 0xFFFFFFFFu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(impl_->scene, &ctx, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return kInf;
+  if (tri_out) *tri_out = rh.hit.primID;
+  return static_cast<double>(rh.ray.tfar);
+}
+
+}  // namespace refit

@@ -1,0 +1,240 @@
+#include <refit/metrics/collision.hpp>
+
+#include <refit/core/error.hpp>
+#include <refit/core/parallel.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace refit {
+
+namespace {
+
+constexpr std::size_t kGrain = 4096;
+
+// What a too-close vertex needs: its displacement along unit `dir` must reach `amount`.
+struct Constraint {
+  Vec3 dir = Vec3::Zero();
+  double amount = 0.0;
+  bool active = false;
+  bool inside = false;
+};
+
+Constraint check_vertex(const Vec3& p, const BodySurface& body, double clearance) {
+  Constraint c;
+  const bool in = body.inside(p);
+  const ClosestPoint cp = in ? body.closest(p) : body.closest_within(p, clearance);
+  if (!in && !(cp.distance < clearance)) return c;
+  c.active = true;
+  c.inside = in;
+  const Vec3 towards = cp.point - p;
+  const double len = towards.norm();
+  // The closest-point direction is the body's normal there (face, edge or vertex
+  // normal alike); on the surface itself only the face normal is left.
+  if (len > 1e-12 * (1.0 + p.norm())) {
+    c.dir = in ? Vec3(towards / len) : Vec3(-towards / len);
+  } else {
+    c.dir = cp.normal;
+  }
+  c.amount = in ? len + clearance : clearance - len;
+  return c;
+}
+
+}  // namespace
+
+Csr vertex_adjacency(const Garment& g) {
+  const std::size_t n = g.vertex_count();
+  std::vector<Index> count(n + 1, 0);
+  auto each_edge = [&](auto&& f) {
+    for (std::size_t r = 0; r < g.faces.rows(); ++r) {
+      const auto face = g.faces.row(r);
+      for (std::size_t k = 0; k < face.size(); ++k) f(face[k], face[(k + 1) % face.size()]);
+    }
+    for (std::size_t r = 0; r < g.lines.rows(); ++r) {
+      const auto line = g.lines.row(r);
+      for (std::size_t k = 0; k + 1 < line.size(); ++k) f(line[k], line[k + 1]);
+    }
+  };
+  each_edge([&](Index a, Index b) {
+    if (a == b) return;
+    ++count[a + 1];
+    ++count[b + 1];
+  });
+  Csr adj;
+  adj.offsets.assign(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) adj.offsets[i + 1] = adj.offsets[i] + count[i + 1];
+  adj.indices.resize(adj.offsets[n]);
+  std::vector<Index> fill(adj.offsets.begin(), adj.offsets.end() - 1);
+  each_edge([&](Index a, Index b) {
+    if (a == b) return;
+    adj.indices[fill[a]++] = b;
+    adj.indices[fill[b]++] = a;
+  });
+  // Sort and drop duplicates (shared edges appear once per face) row by row.
+  std::vector<Index> row_size(n, 0);
+  parallel_for(0, n, kGrain, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      auto* first = adj.indices.data() + adj.offsets[i];
+      auto* last = adj.indices.data() + adj.offsets[i + 1];
+      std::sort(first, last);
+      row_size[i] = static_cast<Index>(std::unique(first, last) - first);
+    }
+  });
+  Index out = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Index begin = adj.offsets[i];
+    std::copy(adj.indices.begin() + begin, adj.indices.begin() + begin + row_size[i], adj.indices.begin() + out);
+    adj.offsets[i] = out;
+    out += row_size[i];
+  }
+  adj.offsets[n] = out;
+  adj.indices.resize(out);
+  return adj;
+}
+
+CollisionReport resolve_penetrations(const Garment& g, Points& positions, const BodySurface& body_b,
+                                     const CollisionOptions& options) {
+  if (positions.rows() != g.positions.rows())
+    throw Error("penetration resolution: " + std::to_string(positions.rows()) + " positions for a garment of " +
+                std::to_string(g.positions.rows()) + " vertices");
+  if (!(options.clearance >= 0.0)) throw Error("penetration resolution: the clearance must be >= 0");
+  const std::size_t n = static_cast<std::size_t>(positions.rows());
+  CollisionReport report;
+  std::vector<Constraint> con(n);
+  std::vector<Index> to_check;  // empty in round 1: check everything
+  std::vector<Index> touched;   // every vertex any round may have moved
+  Csr adj;
+  bool have_adj = false;
+  std::vector<int> ring(n, -1);
+  std::vector<std::uint8_t> finite(n, 0);
+  parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) finite[i] = positions.row(static_cast<Eigen::Index>(i)).allFinite() ? 1 : 0;
+  });
+  report.checked = deterministic_sum<std::size_t>(0, n, kGrain, 0, [&](std::size_t i) { return finite[i]; });
+  std::vector<std::uint8_t> is_touched(n, 0);
+  std::vector<Vec3> first_position;  // aligned with `touched`: where each started
+
+  for (int round = 0; round < std::max(1, options.max_rounds); ++round) {
+    // 1. Which vertices are inside or too close, and where they must go.
+    const std::size_t count = round == 0 ? n : to_check.size();
+    parallel_for(0, count, kGrain / 4, [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) {
+        const std::size_t i = round == 0 ? k : to_check[k];
+        con[i] = finite[i] ? check_vertex(row3(positions, static_cast<Index>(i)), body_b, options.clearance) : Constraint{};
+      }
+    });
+    std::vector<Index> active;
+    for (std::size_t k = 0; k < count; ++k) {
+      const std::size_t i = round == 0 ? k : to_check[k];
+      if (con[i].active) active.push_back(static_cast<Index>(i));
+    }
+    if (round == 0) {
+      report.too_close = active.size();
+      for (Index i : active) report.inside_before += con[i].inside ? 1 : 0;
+    }
+    if (active.empty()) break;
+    report.rounds = round + 1;
+
+    // 2. The region a correction may spread over: up to smoothing_rings edges away.
+    if (!have_adj) {
+      adj = vertex_adjacency(g);
+      have_adj = true;
+    }
+    std::vector<Index> region = active;
+    for (Index i : active) ring[i] = 0;
+    for (std::size_t head = 0, level_end = region.size(), level = 0;
+         head < region.size() && static_cast<int>(level) < options.smoothing_rings; ++level) {
+      for (; head < level_end; ++head)
+        for (Index j : adj.row(region[head]))
+          if (ring[j] < 0 && finite[j]) {
+            ring[j] = static_cast<int>(level) + 1;
+            region.push_back(j);
+          }
+      level_end = region.size();
+    }
+    std::sort(region.begin(), region.end());  // mesh order: deterministic and cache-friendly
+    for (Index i : region)
+      if (!is_touched[i]) {
+        is_touched[i] = 1;
+        touched.push_back(i);
+        first_position.push_back(row3(positions, i));
+      }
+
+    // 3. Jacobi smoothing of the displacement field; constrained vertices keep
+    // at least their required displacement along their direction. Vertices out of
+    // the region count as fixed (zero), which gives the correction its falloff.
+    const std::size_t m = region.size();
+    std::vector<Vec3> disp(m, Vec3::Zero()), next(m);
+    auto slot_of = [&](Index v) -> long {
+      auto it = std::lower_bound(region.begin(), region.end(), v);
+      return (it != region.end() && *it == v) ? static_cast<long>(it - region.begin()) : -1L;
+    };
+    // Each region vertex's in-region neighbours, as slots of `region`.
+    std::vector<std::vector<long>> rows(m);
+    parallel_for(0, m, 256, [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) {
+        for (Index j : adj.row(region[k])) {
+          const long s = slot_of(j);
+          if (s >= 0) rows[k].push_back(s);
+        }
+      }
+    });
+    auto enforce = [&](std::size_t k, Vec3& d) {
+      const Constraint& c = con[region[k]];
+      if (ring[region[k]] != 0 || !c.active) return;
+      const double along = d.dot(c.dir);
+      if (along < c.amount) d += (c.amount - along) * c.dir;
+    };
+    for (std::size_t k = 0; k < m; ++k) enforce(k, disp[k]);
+    for (int pass = 0; pass < options.smoothing_passes; ++pass) {
+      parallel_for(0, m, 1024, [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) {
+          Vec3 sum = disp[k];
+          for (long s : rows[k]) sum += disp[static_cast<std::size_t>(s)];
+          // Out-of-region neighbours contribute zero but still count.
+          const double deg = 1.0 + static_cast<double>(adj.row_size(region[k]));
+          next[k] = sum / deg;
+          enforce(k, next[k]);
+        }
+      });
+      std::swap(disp, next);
+    }
+    parallel_for(0, m, 1024, [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) positions.row(region[k]) += disp[k].transpose();
+    });
+    for (Index i : region) ring[i] = -1;
+    to_check = std::move(region);
+  }
+  // Anything still inside after the last round (reported, never hidden).
+  if (report.rounds > 0) {
+    const std::size_t t = touched.size();
+    report.inside_after = deterministic_sum<std::size_t>(0, t, 256, 0, [&](std::size_t k) {
+      const Vec3 p = row3(positions, touched[k]);
+      return p.allFinite() && body_b.inside(p) ? 1 : 0;
+    });
+  }
+  double total = 0.0;
+  for (std::size_t k = 0; k < touched.size(); ++k) {
+    const double d = (row3(positions, touched[k]) - first_position[k]).norm();
+    if (d > 0.0) {
+      ++report.moved;
+      total += d;
+      report.max_displacement = std::max(report.max_displacement, d);
+    }
+  }
+  report.mean_displacement = report.moved ? total / static_cast<double>(report.moved) : 0.0;
+  return report;
+}
+
+nlohmann::json CollisionReport::to_json() const {
+  return {{"checked", checked},
+          {"inside_before", inside_before},
+          {"too_close", too_close},
+          {"moved", moved},
+          {"max_displacement", max_displacement},
+          {"mean_displacement", mean_displacement},
+          {"inside_after", inside_after},
+          {"rounds", rounds}};
+}
+
+}  // namespace refit

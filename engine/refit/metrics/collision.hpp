@@ -1,0 +1,44 @@
+#pragma once
+// Penetration resolution (beyond the paper; runs after the surface step): garment
+// vertices inside body B or closer than a clearance move out along the body's
+// closest-point normal, and the correction is spread smoothly over their
+// neighbours so no spikes appear.
+#include <refit/body/body_surface.hpp>
+#include <refit/core/garment.hpp>
+
+#include <nlohmann/json.hpp>
+
+namespace refit {
+
+struct CollisionOptions {
+  double clearance = 0.2;       // garment units (0.2 cm)
+  int smoothing_rings = 6;      // how far (in edges) a correction spreads
+  int smoothing_passes = 12;    // Jacobi passes of the displacement field
+  int max_rounds = 3;           // re-check and repeat while something is still too close
+};
+
+struct CollisionReport {
+  std::size_t checked = 0;         // finite vertices tested
+  std::size_t inside_before = 0;   // vertices inside the body before
+  std::size_t too_close = 0;       // vertices inside or within the clearance (the constrained ones)
+  std::size_t moved = 0;           // vertices whose position changed (constrained + spread)
+  double max_displacement = 0.0;
+  double mean_displacement = 0.0;  // over the moved vertices
+  std::size_t inside_after = 0;
+  int rounds = 0;
+
+  nlohmann::json to_json() const;
+};
+
+/// Moves garment vertices out of `body_b` (see above), in place. Vertex
+/// adjacency comes from the garment's faces and `l` lines; vertices farther
+/// than `smoothing_rings` edges from a constrained vertex never move.
+/// Parallel; bit-identical for any thread count. Throws refit::Error when
+/// positions and garment differ in vertex count or the clearance is negative.
+CollisionReport resolve_penetrations(const Garment& g, Points& positions, const BodySurface& body_b,
+                                     const CollisionOptions& options = {});
+
+/// Vertex adjacency (CSR, sorted, no duplicates) from faces and `l` lines.
+Csr vertex_adjacency(const Garment& g);
+
+}  // namespace refit

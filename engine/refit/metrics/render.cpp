@@ -1,0 +1,257 @@
+#include <refit/metrics/render.hpp>
+
+#include <refit/core/error.hpp>
+#include <refit/core/parallel.hpp>
+#include <refit/io/atomic_file.hpp>
+
+#include <embree3/rtcore.h>
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#define STBI_WRITE_NO_STDIO
+#include <stb_image_write.h>
+#pragma GCC diagnostic pop
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+namespace refit {
+
+namespace {
+
+struct Camera {
+  Vec3 forward, right, up;
+};
+
+Camera camera_for(View v) {
+  // Bodies face +Z with +Y up: the front view looks along -Z, the side view
+  // (the body's left side) along -X, the back view along +Z.
+  switch (v) {
+    case View::side: return {Vec3(-1, 0, 0), Vec3(0, 0, -1), Vec3(0, 1, 0)};
+    case View::back: return {Vec3(0, 0, 1), Vec3(-1, 0, 0), Vec3(0, 1, 0)};
+    case View::front: break;
+  }
+  return {Vec3(0, 0, -1), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+}
+
+// One Embree scene: the body (geometry 0) and a garment (geometry 1).
+class Scene {
+ public:
+  Scene(RTCDevice device, const BodyMesh& body, const Garment& garment) : scene_(rtcNewScene(device)) {
+    rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_LOW);  // one picture: build fast, trace little
+    add(device, body.vertices, [&](auto&& emit) {
+      for (const auto& t : body.triangles) emit(t[0], t[1], t[2]);
+    });
+    add(device, garment.positions, [&](auto&& emit) {
+      for (std::size_t f = 0; f < garment.faces.rows(); ++f) {
+        const auto face = garment.faces.row(f);
+        for (std::size_t k = 1; k + 1 < face.size(); ++k) emit(face[0], face[k], face[k + 1]);
+      }
+    });
+    rtcCommitScene(scene_);
+    if (rtcGetDeviceError(device) != RTC_ERROR_NONE) throw Error("render: Embree could not build the scene");
+  }
+  ~Scene() { rtcReleaseScene(scene_); }
+  Scene(const Scene&) = delete;
+  Scene& operator=(const Scene&) = delete;
+  RTCScene get() const { return scene_; }
+
+ private:
+  template <class Triangles>
+  void add(RTCDevice device, const Points& p, Triangles&& triangles) {
+    std::size_t count = 0;
+    const auto finite = [&](Index i) { return p.row(i).allFinite(); };
+    triangles([&](Index a, Index b, Index c) { count += finite(a) && finite(b) && finite(c); });
+    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    const std::size_t nv = static_cast<std::size_t>(p.rows());
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                            3 * sizeof(float), std::max<std::size_t>(nv, 1)));
+    auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                               3 * sizeof(unsigned), count));
+    if (!vb || (count > 0 && !ib)) {
+      rtcReleaseGeometry(geom);
+      throw Error("render: out of memory for the scene");
+    }
+    parallel_for(0, nv, 65536, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i)
+        for (int k = 0; k < 3; ++k) {
+          const double x = p(static_cast<Eigen::Index>(i), k);
+          vb[3 * i + static_cast<std::size_t>(k)] = std::isfinite(x) ? static_cast<float>(x) : 0.0f;
+        }
+    });
+    std::size_t t = 0;
+    triangles([&](Index a, Index b, Index c) {
+      if (!(finite(a) && finite(b) && finite(c))) return;
+      ib[3 * t] = a;
+      ib[3 * t + 1] = b;
+      ib[3 * t + 2] = c;
+      ++t;
+    });
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(scene_, geom);
+    rtcReleaseGeometry(geom);
+  }
+
+  RTCScene scene_;
+};
+
+struct Panel {
+  int x0 = 0, width = 0;
+  int garment = 0;  // 0 or 1
+  Camera camera;
+};
+
+// Bounding box of the finite rows.
+void grow(Vec3& lo, Vec3& hi, const Points& p) {
+  for (Eigen::Index i = 0; i < p.rows(); ++i)
+    if (p.row(i).allFinite()) {
+      lo = lo.cwiseMin(p.row(i).transpose());
+      hi = hi.cwiseMax(p.row(i).transpose());
+    }
+}
+
+}  // namespace
+
+View parse_view(const std::string& name, const std::string& what) {
+  if (name == "front") return View::front;
+  if (name == "side") return View::side;
+  if (name == "back") return View::back;
+  throw Error(what + ": unknown view '" + name + "' (expected front, side or back)");
+}
+
+Image render(const BodyMesh& body, const Garment& garment, const Garment* garment2, const std::vector<Points>& curves,
+             const RenderOptions& options) {
+  if (options.width < 16 || options.height < 16 || options.width > 16384 || options.height > 16384)
+    throw Error("render: picture size " + std::to_string(options.width) + "x" + std::to_string(options.height) +
+                " is out of range (16 to 16384 per side)");
+  if (options.views.empty()) throw Error("render: no view requested");
+
+  std::unique_ptr<RTCDeviceTy, void (*)(RTCDevice)> device(rtcNewDevice(nullptr), rtcReleaseDevice);
+  if (!device) throw Error("render: cannot create an Embree device");
+  std::vector<std::unique_ptr<Scene>> scenes;
+  scenes.push_back(std::make_unique<Scene>(device.get(), body, garment));
+  if (garment2) scenes.push_back(std::make_unique<Scene>(device.get(), body, *garment2));
+
+  // The same framing in every panel, so the pictures compare at a glance.
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  grow(lo, hi, body.vertices);
+  grow(lo, hi, garment.positions);
+  if (garment2) grow(lo, hi, garment2->positions);
+  if (!lo.allFinite()) throw Error("render: nothing finite to draw");
+  const Vec3 centre = 0.5 * (lo + hi);
+  const double depth = (hi - lo).norm() + 1.0;
+
+  std::vector<Panel> panels;
+  const int count = static_cast<int>(scenes.size() * options.views.size());
+  for (int g = 0; g < static_cast<int>(scenes.size()); ++g)
+    for (View v : options.views) {
+      Panel p;
+      const int index = static_cast<int>(panels.size());
+      p.x0 = index * options.width / count;
+      p.width = (index + 1) * options.width / count - p.x0;
+      p.garment = g;
+      p.camera = camera_for(v);
+      panels.push_back(p);
+    }
+  // Pixel size per panel: the box's extent across and up the view, with a margin.
+  std::vector<double> pixel(panels.size());
+  for (std::size_t i = 0; i < panels.size(); ++i) {
+    const Camera& c = panels[i].camera;
+    const Vec3 ext = hi - lo;
+    const double across = std::abs(ext.dot(c.right)), upward = std::abs(ext.dot(c.up));
+    pixel[i] = 1.08 * std::max(across / std::max(panels[i].width, 1), upward / options.height) + 1e-12;
+  }
+
+  Image img;
+  img.width = options.width;
+  img.height = options.height;
+  img.rgb.assign(static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height) * 3, kBackground[0]);
+  const std::array<Vec3, 3> colour = {Vec3(0.82, 0.74, 0.66), Vec3(0.25, 0.45, 0.85), Vec3(0.85, 0.42, 0.25)};
+  const double ambient = 0.18;
+
+  parallel_for(0, static_cast<std::size_t>(img.height), 8, [&](std::size_t y0, std::size_t y1) {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    for (std::size_t y = y0; y < y1; ++y)
+      for (std::size_t pi = 0; pi < panels.size(); ++pi) {
+        const Panel& p = panels[pi];
+        const Camera& c = p.camera;
+        for (int x = p.x0; x < p.x0 + p.width; ++x) {
+          const double u = (x - p.x0 + 0.5 - 0.5 * p.width) * pixel[pi];
+          const double v = (0.5 * img.height - (static_cast<double>(y) + 0.5)) * pixel[pi];
+          const Vec3 o = centre + u * c.right + v * c.up - depth * c.forward;
+          RTCRayHit rh;
+          rh.ray.org_x = static_cast<float>(o.x());
+          rh.ray.org_y = static_cast<float>(o.y());
+          rh.ray.org_z = static_cast<float>(o.z());
+          rh.ray.dir_x = static_cast<float>(c.forward.x());
+          rh.ray.dir_y = static_cast<float>(c.forward.y());
+          rh.ray.dir_z = static_cast<float>(c.forward.z());
+          rh.ray.tnear = 0.0f;
+          rh.ray.tfar = std::numeric_limits<float>::infinity();
+          rh.ray.time = 0.0f;
+          rh.ray.mask = 0xFFFFFFFFu;
+          rh.ray.id = 0;
+          rh.ray.flags = 0;
+          rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+          rtcIntersect1(scenes[static_cast<std::size_t>(p.garment)]->get(), &ctx, &rh);
+          if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+          Vec3 n(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
+          const double len = n.norm();
+          // Headlight, shaded on both sides: garments are open shells seen from either side.
+          const double lambert = len > 0.0 ? std::abs(n.dot(c.forward)) / len : 0.0;
+          const Vec3 base = rh.hit.geomID == 0 ? colour[0] : colour[1 + static_cast<std::size_t>(p.garment)];
+          const Vec3 rgb = base * (ambient + (1.0 - ambient) * lambert);
+          std::uint8_t* px = &img.rgb[(y * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(x)) * 3];
+          for (int k = 0; k < 3; ++k) px[k] = static_cast<std::uint8_t>(std::clamp(rgb[k] * 255.0 + 0.5, 0.0, 255.0));
+        }
+      }
+  });
+
+  // Feature curves on top of garment 1's panels: thick red lines, no depth test.
+  const double radius = std::max(1.5, options.height / 400.0);
+  for (std::size_t pi = 0; pi < panels.size(); ++pi) {
+    const Panel& p = panels[pi];
+    if (p.garment != 0) continue;
+    auto to_pixel = [&](const Vec3& q) {
+      const Vec3 d = q - centre;
+      return Eigen::Vector2d(p.x0 + 0.5 * p.width + d.dot(p.camera.right) / pixel[pi],
+                             0.5 * img.height - d.dot(p.camera.up) / pixel[pi]);
+    };
+    auto stamp = [&](const Eigen::Vector2d& s) {
+      for (int y = static_cast<int>(std::floor(s.y() - radius)); y <= static_cast<int>(std::ceil(s.y() + radius)); ++y)
+        for (int x = static_cast<int>(std::floor(s.x() - radius)); x <= static_cast<int>(std::ceil(s.x() + radius)); ++x) {
+          if (y < 0 || y >= img.height || x < p.x0 || x >= p.x0 + p.width) continue;
+          if ((Eigen::Vector2d(x + 0.5, y + 0.5) - s).norm() > radius) continue;
+          std::uint8_t* px = &img.rgb[(static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(x)) * 3];
+          px[0] = 220;
+          px[1] = 20;
+          px[2] = 60;
+        }
+    };
+    for (const Points& curve : curves)
+      for (Eigen::Index i = 0; i + 1 < curve.rows(); ++i) {
+        if (!curve.row(i).allFinite() || !curve.row(i + 1).allFinite()) continue;
+        const Eigen::Vector2d a = to_pixel(curve.row(i).transpose()), b = to_pixel(curve.row(i + 1).transpose());
+        const int steps = std::min(100000, static_cast<int>(std::ceil((b - a).norm() / 0.5)) + 1);
+        for (int s = 0; s <= steps; ++s) stamp(a + (b - a) * (static_cast<double>(s) / steps));
+      }
+  }
+  return img;
+}
+
+void write_png(const std::string& path, const Image& image) {
+  std::string bytes;
+  const int ok = stbi_write_png_to_func(
+      [](void* context, void* data, int size) { static_cast<std::string*>(context)->append(static_cast<const char*>(data), static_cast<std::size_t>(size)); },
+      &bytes, image.width, image.height, 3, image.rgb.data(), image.width * 3);
+  if (!ok) throw Error(path + ": could not encode the PNG");
+  write_file_atomically(path, [&](std::ostream& out) { out.write(bytes.data(), static_cast<std::streamsize>(bytes.size())); });
+}
+
+}  // namespace refit

@@ -1,0 +1,450 @@
+// Metrics, penetration resolution and rendering.
+#include <refit/core/error.hpp>
+#include <refit/core/parallel.hpp>
+#include <refit/metrics/collision.hpp>
+#include <refit/metrics/metrics.hpp>
+#include <refit/metrics/render.hpp>
+
+#include <mannequin/mannequin.hpp>
+
+#include "support/test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#define STB_IMAGE_IMPLEMENTATION
+#include <stb/stb_image.h>
+#pragma GCC diagnostic pop
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace refit {
+namespace {
+
+// Icosphere (outward triangles) as vertices + triangles.
+std::pair<Points, std::vector<std::array<Index, 3>>> icosphere(int levels, double radius) {
+  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+  std::vector<Vec3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                         {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<std::array<Index, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                         {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                         {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                         {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  for (auto& p : v) p.normalize();
+  for (int l = 0; l < levels; ++l) {
+    std::map<std::pair<Index, Index>, Index> mid;
+    auto midpoint = [&](Index a, Index b) {
+      auto key = std::minmax(a, b);
+      auto it = mid.find(key);
+      if (it != mid.end()) return it->second;
+      v.push_back((v[a] + v[b]).normalized());
+      return mid[key] = static_cast<Index>(v.size() - 1);
+    };
+    std::vector<std::array<Index, 3>> g;
+    for (auto& tri : f) {
+      const Index a = midpoint(tri[0], tri[1]), b = midpoint(tri[1], tri[2]), c = midpoint(tri[2], tri[0]);
+      g.push_back({tri[0], a, c});
+      g.push_back({tri[1], b, a});
+      g.push_back({tri[2], c, b});
+      g.push_back({a, b, c});
+    }
+    f = std::move(g);
+  }
+  Points p(static_cast<Eigen::Index>(v.size()), 3);
+  for (std::size_t i = 0; i < v.size(); ++i) p.row(static_cast<Eigen::Index>(i)) = radius * v[i].transpose();
+  return {p, f};
+}
+
+BodyMesh sphere_body(int levels, double radius) {
+  auto [p, f] = icosphere(levels, radius);
+  BodyMesh m;
+  m.vertices = p;
+  m.triangles = f;
+  m.name = "sphere";
+  return m;
+}
+
+Garment sphere_garment(int levels, double radius) {
+  auto [p, f] = icosphere(levels, radius);
+  Garment g;
+  g.positions = p;
+  for (const auto& t : f) g.faces.push_row(t);
+  return g;
+}
+
+// -- profile straightness ----------------------------------------------------
+
+TEST(Metrics, StraightnessIsZeroForSimilarCopiesAndSeesABulge) {
+  Points line(11, 3);
+  for (int i = 0; i < 11; ++i) line.row(i) << i, 0.0, 0.0;
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  Points copy = ((2.5 * line * r.transpose()).rowwise() + Eigen::RowVector3d(4, -1, 2)).eval();
+  EXPECT_NEAR(profile_straightness(copy, line, false), 0.0, 1e-12);
+  Points bent = line;
+  bent(5, 1) = 1.0;
+  // Least squares spreads the bump: about (1 - 1/11) / 10 remains at the bent point.
+  const double s = profile_straightness(bent, line, false);
+  EXPECT_GT(s, 0.08);
+  EXPECT_LT(s, 0.1);
+  EXPECT_THROW(profile_straightness(bent.topRows(5), line, false), Error);
+}
+
+// -- compute_metrics on a known case --------------------------------------------
+
+TEST(Metrics, SphereShellScaledAndShiftedGivesTheExpectedNumbers) {
+  const BodyMesh a = sphere_body(4, 10.0), b = sphere_body(4, 11.0);
+  const Garment g = sphere_garment(3, 10.5);
+  const BodySurface sa(a), sb(b);
+  // Facets sit inside the sphere by at most this much (level 4, r = 11).
+  const double facet = 11.0 * (1.0 - std::cos(0.04));
+
+  // Scaled to r = 11.3 around B (r = 11): every vertex was 0.5 from A and is 0.3 from B.
+  Points scaled = g.positions * (11.3 / 10.5);
+  ResizeMetrics m = compute_metrics(g, scaled, sa, sb);
+  EXPECT_EQ(m.vertices, g.vertex_count());
+  EXPECT_EQ(m.fit.vertices, g.vertex_count());
+  EXPECT_NEAR(m.fit.mean_change, -0.2, facet);
+  EXPECT_NEAR(m.fit.max_abs_change, 0.2, facet);
+  EXPECT_EQ(m.penetration.inside, 0u);
+  EXPECT_EQ(m.sanity.nan_vertices, 0u);
+  EXPECT_EQ(m.sanity.flipped_faces, 0u);
+  EXPECT_EQ(m.sanity.faces_checked, g.faces.rows());
+  EXPECT_NEAR(m.sanity.edge_ratio_p1, 11.3 / 10.5, 1e-12);
+  EXPECT_NEAR(m.sanity.edge_ratio_p99, 11.3 / 10.5, 1e-12);
+
+  // Shifted by 3 along +z on the unchanged shell around B: the vertices that
+  // land inside r = 11 (less the facet margin) are inside.
+  Points shifted = g.positions.rowwise() + Eigen::RowVector3d(0, 0, 3);
+  std::size_t expected = 0, ambiguous = 0;
+  double deepest = 0.0;
+  for (Eigen::Index i = 0; i < shifted.rows(); ++i) {
+    const double r = shifted.row(i).norm();
+    if (r < 11.0 - facet) {
+      ++expected;
+      deepest = std::max(deepest, 11.0 - r);
+    } else if (r < 11.0) {
+      ++ambiguous;
+    }
+  }
+  m = compute_metrics(g, shifted, sa, sb);
+  EXPECT_GE(m.penetration.inside, expected);
+  EXPECT_LE(m.penetration.inside, expected + ambiguous);
+  EXPECT_NEAR(m.penetration.fraction, double(m.penetration.inside) / double(g.vertex_count()), 1e-15);
+  EXPECT_NEAR(m.penetration.deepest, deepest, facet);
+  EXPECT_EQ(m.sanity.flipped_faces, 0u);
+  EXPECT_NEAR(m.sanity.edge_ratio_p50, 1.0, 1e-12);
+
+  // A NaN row is counted and never reaches the numbers (JSON has no null).
+  Points broken = g.positions;
+  broken(0, 1) = std::nan("");
+  const SanityMetrics s = measure_sanity(g, broken);
+  EXPECT_EQ(s.nan_vertices, 1u);
+  EXPECT_EQ(s.flipped_faces, 0u);
+  EXPECT_EQ(s.faces_checked, g.faces.rows() - 5);  // the five faces around vertex 0 are skipped
+  const auto j = compute_metrics(g, broken, sa, sb).to_json();
+  EXPECT_EQ(j.dump().find("null"), std::string::npos) << j.dump();
+  EXPECT_EQ(j["penetration"]["checked"], g.vertex_count() - 1);
+
+  EXPECT_THROW(compute_metrics(g, Points(3, 3), sa, sb), Error);
+}
+
+TEST(Metrics, FeatureScoresOfASimilarCopyAreZero) {
+  MetricsOptions o;
+  FeatureCurveInput c;
+  c.name = "hem";
+  c.closed = true;
+  c.original.resize(12, 3);
+  for (int i = 0; i < 12; ++i) c.original.row(i) << std::cos(i * M_PI / 6), 0.3 * std::sin(i * M_PI / 6), 0.0;
+  c.result = (c.original * 1.2).rowwise() + Eigen::RowVector3d(0, 1, 0);
+  c.warped = c.original;
+  c.warped(3, 2) = 0.2;
+  o.features.push_back(c);
+  const Garment g = sphere_garment(1, 10.5);
+  const BodySurface a(sphere_body(2, 10.0));
+  const ResizeMetrics m = compute_metrics(g, g.positions, a, a, o);
+  ASSERT_EQ(m.features.size(), 1u);
+  EXPECT_NEAR(m.features[0].result.shape_error, 0.0, 1e-12);
+  EXPECT_NEAR(m.features[0].result.turning_change_deg, 0.0, 1e-9);
+  EXPECT_NEAR(m.features[0].result.straightness, 0.0, 1e-12);
+  EXPECT_TRUE(m.features[0].has_warp);
+  EXPECT_GT(m.features[0].warp.straightness, 0.005);
+  EXPECT_GT(m.features[0].warp.turning_change_deg, 0.1);
+}
+
+TEST(Metrics, FlippedFacesOfAMirroredSheet) {
+  Garment sheet;
+  sheet.positions.resize(9, 3);
+  for (int i = 0; i < 9; ++i) sheet.positions.row(i) << i % 3, i / 3, 0.0;
+  for (Index r = 0; r < 2; ++r)
+    for (Index c = 0; c < 2; ++c) {
+      const std::array<Index, 4> q = {3 * r + c, 3 * r + c + 1, 3 * r + c + 4, 3 * r + c + 3};
+      sheet.faces.push_row(q);
+    }
+  Points mirrored = sheet.positions;
+  mirrored.col(0) *= -1.0;
+  EXPECT_EQ(measure_sanity(sheet, mirrored).flipped_faces, 4u);
+  Points folded = sheet.positions;
+  folded(0, 0) = 1.5;  // corner vertex pulled over: only its quad turns over
+  folded(0, 1) = 1.5;
+  const SanityMetrics s = measure_sanity(sheet, folded);
+  EXPECT_EQ(s.flipped_faces, 1u);
+  EXPECT_EQ(s.faces_checked, 4u);
+}
+
+// -- penetration resolution -----------------------------------------------------
+
+struct Pushed {
+  BodyMesh body;
+  Garment garment;
+  Points pushed;
+};
+
+// The mannequin's top, with the front of the torso band between two heights
+// pushed 2 cm into the body.
+Pushed pushed_top() {
+  mannequin::BodyParams bp;
+  Pushed p;
+  p.body = mannequin::make_body(bp);
+  mannequin::GarmentParams gp;
+  gp.kind = mannequin::GarmentParams::Kind::Top;
+  gp.target_vertices = 6000;
+  p.garment = mannequin::make_garment(bp, gp);
+  const auto lm = mannequin::landmarks(bp);
+  p.pushed = p.garment.positions;
+  for (Eigen::Index i = 0; i < p.pushed.rows(); ++i) {
+    const double y = p.pushed(i, 1), z = p.pushed(i, 2);
+    if (y > lm.waist && y < lm.bust && z > 0.0) {
+      const double w = std::sin(M_PI * (y - lm.waist) / (lm.bust - lm.waist));
+      const double front = std::clamp(z / 10.0, 0.0, 1.0);
+      p.pushed(i, 2) -= 2.5 * w * front * front * (3.0 - 2.0 * front);
+    }
+  }
+  return p;
+}
+
+TEST(Collision, PushedTopComesOutSmoothlyAndOnlyLocally) {
+  Pushed p = pushed_top();
+  const BodySurface body(p.body);
+  const PenetrationMetrics before = measure_penetration(p.pushed, body);
+  ASSERT_GT(before.inside, 50u) << "the fixture must start inside the body";
+
+  CollisionOptions o;
+  Points out = p.pushed;
+  const CollisionReport r = resolve_penetrations(p.garment, out, body, o);
+  EXPECT_EQ(r.inside_before, before.inside);
+  EXPECT_EQ(r.inside_after, 0u);
+  EXPECT_EQ(measure_penetration(out, body).inside, 0u);
+  EXPECT_GE(r.moved, r.too_close);
+  EXPECT_GT(r.max_displacement, 1.0);
+
+  // No face flipped that was not flipped already (relative to the pushed input
+  // and to the garment as designed).
+  Garment pushed_garment = p.garment;
+  pushed_garment.positions = p.pushed;
+  EXPECT_EQ(measure_sanity(pushed_garment, out).flipped_faces, 0u);
+  EXPECT_LE(measure_sanity(p.garment, out).flipped_faces, measure_sanity(p.garment, p.pushed).flipped_faces);
+
+  // Untouched: vertices beyond the clearance and more than smoothing_rings edges
+  // from any too-close vertex keep their exact position; everything that moved
+  // is within those rings.
+  const Csr adj = vertex_adjacency(p.garment);
+  const std::size_t n = p.garment.vertex_count();
+  std::vector<int> ring(n, -1);
+  std::vector<Index> frontier;
+  for (Index i = 0; i < n; ++i) {
+    const Vec3 q = row3(p.pushed, i);
+    if (body.inside(q) || body.closest(q).distance < o.clearance) {
+      ring[i] = 0;
+      frontier.push_back(i);
+    }
+  }
+  for (int level = 1; level <= o.smoothing_rings; ++level) {
+    std::vector<Index> next;
+    for (Index i : frontier)
+      for (Index j : adj.row(i))
+        if (ring[j] < 0) {
+          ring[j] = level;
+          next.push_back(j);
+        }
+    frontier = std::move(next);
+  }
+  std::size_t far_untouched = 0, moved = 0;
+  double max_step_ratio = 0.0;
+  for (Index i = 0; i < n; ++i) {
+    const bool changed = (out.row(i) - p.pushed.row(i)).squaredNorm() > 0.0;
+    moved += changed;
+    if (ring[i] < 0) {
+      EXPECT_FALSE(changed) << "vertex " << i << " is far from every too-close vertex but moved";
+      ++far_untouched;
+    }
+  }
+  EXPECT_GT(far_untouched, n / 2);
+  EXPECT_EQ(moved, r.moved);
+  // Smooth: along every edge, the displacement difference stays well below the
+  // largest displacement (a spike would make one edge carry all of it).
+  for (Index i = 0; i < n; ++i)
+    for (Index j : adj.row(i)) {
+      const double di = (out.row(i) - p.pushed.row(i)).norm(), dj = (out.row(j) - p.pushed.row(j)).norm();
+      max_step_ratio = std::max(max_step_ratio, std::abs(di - dj) / r.max_displacement);
+    }
+  EXPECT_LT(max_step_ratio, 0.6);
+
+  // Nothing to do on the garment as designed (already outside the clearance).
+  Points designed = p.garment.positions;
+  const CollisionReport none = resolve_penetrations(p.garment, designed, body, o);
+  EXPECT_EQ(none.too_close, 0u);
+  EXPECT_EQ(none.moved, 0u);
+  EXPECT_TRUE(designed == p.garment.positions);
+}
+
+TEST(Collision, SphereShellPartlyInsideComesOutBitIdenticalForAnyThreadCount) {
+  const BodySurface body(sphere_body(3, 10.0));
+  const Garment g = sphere_garment(3, 10.4);
+  Points shifted = g.positions.rowwise() + Eigen::RowVector3d(1.5, 0, 0);
+  Points one = shifted, two = shifted;
+  CollisionReport r1, r2;
+  {
+    ThreadLimit limit(1);
+    r1 = resolve_penetrations(g, one, body);
+  }
+  r2 = resolve_penetrations(g, two, body);
+  EXPECT_GT(r1.inside_before, 10u);
+  EXPECT_EQ(r1.inside_after, 0u);
+  EXPECT_TRUE(one == two);
+  EXPECT_EQ(r1.moved, r2.moved);
+  EXPECT_EQ(measure_penetration(one, body).inside, 0u);
+  EXPECT_EQ(measure_sanity(g, one).flipped_faces, 0u);
+  for (Eigen::Index i = 0; i < one.rows(); ++i) EXPECT_GT(body.closest(row3(one, static_cast<Index>(i))).distance, 0.2 - 1e-9);
+  EXPECT_THROW(resolve_penetrations(g, shifted, body, CollisionOptions{-1.0}), Error);
+}
+
+// -- render ---------------------------------------------------------------------
+
+TEST(Render, WritesAPngOfTheRequestedSizeWithContent) {
+  mannequin::BodyParams bp;
+  const BodyMesh body = mannequin::make_body(bp);
+  mannequin::GarmentParams gp;
+  gp.target_vertices = 4000;
+  const Garment dress = mannequin::make_garment(bp, gp);
+  std::vector<Points> curves(1, Points(2, 3));
+  curves[0] << -20, 100, 30, 20, 100, 30;
+  RenderOptions o;
+  o.width = 240;
+  o.height = 300;
+  o.views = {View::front, View::side};
+  const Image img = render(body, dress, &dress, curves, o);
+  ASSERT_EQ(img.width, 240);
+  ASSERT_EQ(img.height, 300);
+  test::TempDir dir;
+  const std::string path = dir.file("pic.png");
+  write_png(path, img);
+  int w = 0, h = 0, ch = 0;
+  unsigned char* data = stbi_load(path.c_str(), &w, &h, &ch, 3);
+  ASSERT_NE(data, nullptr);
+  EXPECT_EQ(w, 240);
+  EXPECT_EQ(h, 300);
+  std::size_t background = 0, red = 0, garment_blue = 0, garment_orange = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const unsigned char* p = data + 3 * (y * w + x);
+      if (p[0] == 255 && p[1] == 255 && p[2] == 255) ++background;
+      if (p[0] == 220 && p[1] == 20 && p[2] == 60) ++red;
+      if (p[2] > p[0] + 40) (x < w / 2 ? garment_blue : garment_orange) += 1;
+      if (p[0] > p[2] + 60 && p[1] < 150 && x >= w / 2) ++garment_orange;
+    }
+  stbi_image_free(data);
+  EXPECT_LT(background, std::size_t(w * h));
+  EXPECT_GT(background, std::size_t(w * h / 3));
+  EXPECT_GT(red, 20u);
+  EXPECT_GT(garment_blue, 200u);
+  EXPECT_GT(garment_orange, 200u);
+  // Same input, same picture.
+  EXPECT_TRUE(render(body, dress, &dress, curves, o).rgb == img.rgb);
+  o.width = 4;
+  EXPECT_THROW(render(body, dress, nullptr, curves, o), Error);
+}
+
+// -- the commands ---------------------------------------------------------------
+
+bool cli_built() { return std::filesystem::exists(REFIT_CLI_PATH); }
+
+TEST(CompareCommand, ShiftedGarmentGivesTheExpectedNumbers) {
+  if (!cli_built()) GTEST_SKIP() << "the refit command line is not built";
+  const std::string dir = test::shared_data_dir();
+  if (dir.empty()) GTEST_SKIP() << "shared data (../shared/data) not found";
+  test::TempDir tmp;
+  // The skirt moved 0.5 cm up: same body, so fit and sanity are known.
+  const std::string garment = dir + "/garments/skirt_on_A_female.obj", body = dir + "/bodies/A_female.obj";
+  std::string text = test::read_text(garment), shifted;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("v ", 0) == 0) {
+      std::istringstream ss(line.substr(2));
+      double x, y, z;
+      ss >> x >> y >> z;
+      std::ostringstream os;
+      os.precision(17);
+      os << "v " << x << ' ' << y + 0.5 << ' ' << z;
+      line = os.str();
+    }
+    shifted += line + "\n";
+  }
+  test::write_text(tmp.file("shifted.obj"), shifted);
+  const auto r = test::run_cli("compare --garment '" + garment + "' --from '" + body + "' --to '" + body +
+                               "' --result '" + tmp.file("shifted.obj") + "' --report '" + tmp.file("c.json") + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(test::read_text(tmp.file("c.json")));
+  EXPECT_EQ(j["vertices"], 720);
+  EXPECT_EQ(j["sanity"]["flipped_faces"], 0);
+  EXPECT_NEAR(j["sanity"]["edge_ratio_p1"].get<double>(), 1.0, 1e-9);
+  EXPECT_NEAR(j["sanity"]["edge_ratio_p99"].get<double>(), 1.0, 1e-9);
+  EXPECT_EQ(j["sanity"]["nan_vertices"], 0);
+  // A shift of 0.5 changes no distance by more than 0.5.
+  EXPECT_LE(j["fit"]["max_abs_change"].get<double>(), 0.5 + 1e-9);
+  EXPECT_GT(j["fit"]["vertices"].get<int>(), 0);
+
+  // Different vertex count: a clear one-line error naming the file.
+  test::write_text(tmp.file("small.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const auto bad = test::run_cli("compare --garment '" + garment + "' --from '" + body + "' --to '" + body +
+                                 "' --result '" + tmp.file("small.obj") + "'");
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("small.obj"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("same vertex order"), std::string::npos) << bad.err;
+}
+
+TEST(RenderCommand, WritesThePicture) {
+  if (!cli_built()) GTEST_SKIP() << "the refit command line is not built";
+  const std::string dir = test::shared_data_dir();
+  if (dir.empty()) GTEST_SKIP() << "shared data (../shared/data) not found";
+  test::TempDir tmp;
+  const auto r = test::run_cli("render --body '" + dir + "/bodies/A_female.obj' --garment '" + dir +
+                               "/garments/skirt_on_A_female.obj' --views front,side --size 320x200 --out '" +
+                               tmp.file("p.png") + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  int w = 0, h = 0, ch = 0;
+  unsigned char* data = stbi_load(tmp.file("p.png").c_str(), &w, &h, &ch, 3);
+  ASSERT_NE(data, nullptr);
+  EXPECT_EQ(w, 320);
+  EXPECT_EQ(h, 200);
+  std::size_t content = 0;
+  for (int i = 0; i < w * h; ++i) content += !(data[3 * i] == 255 && data[3 * i + 1] == 255 && data[3 * i + 2] == 255);
+  stbi_image_free(data);
+  EXPECT_GT(content, 1000u);
+  const auto bad = test::run_cli("render --body '" + dir + "/bodies/A_female.obj' --garment '" + dir +
+                                 "/garments/skirt_on_A_female.obj' --size 320by200 --out '" + tmp.file("q.png") + "'");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.err.find("--size"), std::string::npos) << bad.err;
+}
+
+}  // namespace
+}  // namespace refit
