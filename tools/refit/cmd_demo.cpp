@@ -13,6 +13,7 @@
 #include <refit/io/atomic_file.hpp>
 #include <refit/io/body_io.hpp>
 #include <refit/io/obj_garment.hpp>
+#include <refit/metrics/render.hpp>
 #include <refit/pipeline/resize.hpp>
 
 #include <cstdio>
@@ -53,9 +54,12 @@ int run(const DemoArgs& a) {
 
   // From here on the demo is what `refit resize` does with those files.
   auto garment = std::make_shared<const Garment>(read_garment_obj(path("dress_on_A.obj")));
-  const GarmentBinding binding(garment, read_body(path("body_A.obj")), ResizeOptions{},
+  ResizeOptions options;
+  options.metrics = true;
+  const GarmentBinding binding(garment, read_body(path("body_A.obj")), options,
                                read_feature_file(path("dress_features.json")), progress);
-  ResizeResult result = binding.resize(read_body(path("body_B.obj")), progress);
+  const BodyMesh body_b = read_body(path("body_B.obj"));
+  ResizeResult result = binding.resize(body_b, progress);
 
   Garment out = *garment;
   out.positions = result.warped;
@@ -69,6 +73,21 @@ int run(const DemoArgs& a) {
   result.report["warnings"] = result.warnings;
   write_json_report(path("report.json"), result.report);
 
+  // Pictures: the design on body A; then on body B the warp alone (left, with the
+  // optimised feature curves drawn where the profiles should be) beside Refit's result (right).
+  progress.stage("rendering pictures");
+  RenderOptions views;
+  views.width = 1200;
+  views.height = 800;
+  views.views = {View::front, View::side};
+  std::vector<Points> curves;
+  for (const CurveResult& c : result.features.curves) curves.push_back(c.optimised);
+  Garment warp_only = *garment;
+  warp_only.positions = result.warped;
+  write_png(path("before_after.png"), render(body_b, warp_only, &out, curves, views));
+  views.width = 600;
+  write_png(path("design_on_A.png"), render(binding.body_a().mesh(), *garment, nullptr, {}, views));
+
   std::printf("refit demo: dress of %zu vertices resized from body_A to body_B (belly %+g cm, hip %g cm)\n",
               garment->vertex_count(), a.body_b.belly, a.body_b.hip);
   std::printf("  %-16s %14s %14s %14s\n", "feature", "error (warp)", "error (curve)", "error (output)");
@@ -77,7 +96,10 @@ int run(const DemoArgs& a) {
                 f["shape_error_warped"].get<double>(), f["shape_error_result"].get<double>(),
                 f.value("shape_error_output", 0.0));
   std::printf("  (shape error: RMS distance to the original curve after the best similarity, / curve length)\n");
-  std::printf("output: %s (dress_on_B.obj, dress_on_B_warp_only.obj, dress_curves.obj, report.json, bodies, inputs)\n",
+  const auto& m = result.report["metrics"];
+  std::printf("  vertices inside body B: warp %zu, result %zu\n", m["warp"]["penetration"].value("inside", std::size_t{0}),
+              m["result"]["penetration"].value("inside", std::size_t{0}));
+  std::printf("output: %s (dress_on_B.obj, dress_on_B_warp_only.obj, before_after.png, report.json, ...)\n",
               fs::absolute(a.out_dir).c_str());
   return 0;
 }

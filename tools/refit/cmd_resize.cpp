@@ -20,7 +20,7 @@ struct ResizeArgs {
   std::string garment, from, out, out_dir, report, features, curves_out, units = "cm", stage = "full";
   std::vector<std::string> to;
   std::size_t threads = 0, max_triangles = WarpOptions{}.max_triangles;
-  bool quiet = false, paper_closeness = false, no_shape_control = false, no_collision = false, encode_on_warped = false;
+  bool quiet = false, metrics = false, paper_closeness = false, no_shape_control = false, no_collision = false, encode_on_warped = false;
   SurfaceOptions surface;
   double clearance = 0.2;
 };
@@ -47,6 +47,7 @@ int run(const ResizeArgs& a) {
   options.shape_matching.sampling_invariant = !a.paper_closeness;
   options.surface.encode_on_warped = a.encode_on_warped;
   options.collision = !a.no_collision;
+  options.metrics = a.metrics;
   options.clearance_cm = a.clearance;
   if (!a.curves_out.empty() && a.features.empty()) throw Error("--curves-out needs --features");
   if (!a.curves_out.empty() && a.to.size() > 1) throw Error("--curves-out works with one --to body");
@@ -145,6 +146,7 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
   app.add_flag("--encode-on-warped", a->encode_on_warped, "Encode the local shape on the warped garment, not the original");
   app.add_flag("--no-collision", a->no_collision, "Do not push vertices inside body B out");
   app.add_option("--clearance", a->clearance, "Collision clearance outside body B in cm")->capture_default_str();
+  app.add_flag("--metrics", a->metrics, "Add fit, penetration and surface metrics of the warp and the result to the report");
   app.add_flag("--quiet", a->quiet, "No progress on stderr");
   return [a]() { return run(*a); };
 });

@@ -3,6 +3,8 @@
 #include <refit/core/error.hpp>
 #include <refit/features/curve_metrics.hpp>
 #include <refit/features/feature_curves.hpp>
+#include <refit/metrics/collision.hpp>
+#include <refit/metrics/metrics.hpp>
 #include <refit/pipeline/resize.hpp>
 #include <refit/pipeline/units.hpp>
 
@@ -228,6 +230,27 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
     }
   }
   if (!result.positions.allFinite()) throw Error("internal: the surface step produced a non-finite position");
+
+  // Beyond the paper: nothing of the garment may end inside body B.
+  if (surface_ && options_.collision) {
+    clock.reset();
+    progress.stage("resolving penetrations");
+    CollisionOptions co;
+    co.clearance = options_.clearance_cm * units_per_cm(options_.units);
+    const CollisionReport c = resolve_penetrations(*garment_, result.positions, surface_b, co);
+    timings["collision"] = clock.ms();
+    report["collision"] = c.to_json();
+    if (c.inside_after > 0)
+      result.warnings.push_back(std::to_string(c.inside_after) + " vertices are still inside body B after collision resolution");
+  }
+  if (options_.metrics) {
+    clock.reset();
+    progress.stage("measuring");
+    const BodySurface surface_a(body_a_.mesh());
+    report["metrics"] = {{"warp", compute_metrics(*garment_, result.warped, surface_a, surface_b).to_json()},
+                         {"result", compute_metrics(*garment_, result.positions, surface_a, surface_b).to_json()}};
+    timings["metrics"] = clock.ms();
+  }
   return result;
 }
 

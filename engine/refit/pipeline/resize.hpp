@@ -31,6 +31,7 @@ struct ResizeOptions {
   SurfaceOptions surface;      // epsilon and voxel in cm here; converted to garment units
   bool collision = true;       // push vertices inside body B out (beyond the paper)
   double clearance_cm = 0.2;   // ... to this distance outside the body
+  bool metrics = false;        // add fit, penetration and sanity metrics (warp and result) to the report
 };
 
 struct ResizeResult {
