@@ -1,0 +1,205 @@
+#include <refit/core/topology.hpp>
+
+#include <refit/core/error.hpp>
+
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <numeric>
+#include <string>
+
+namespace refit {
+namespace {
+
+// An undirected edge as one sortable key: smaller vertex in the high half.
+std::uint64_t edge_key(Index a, Index b) {
+  if (a > b) std::swap(a, b);
+  return (std::uint64_t(a) << 32) | b;
+}
+Index key_lo(std::uint64_t k) { return static_cast<Index>(k >> 32); }
+Index key_hi(std::uint64_t k) { return static_cast<Index>(k & 0xffffffffu); }
+
+void check_indices(const Garment& g) {
+  const std::size_t n = g.vertex_count();
+  const auto check = [&](const Csr& csr, const char* what) {
+    for (Index i : csr.indices)
+      if (i >= n)
+        throw Error("garment: a " + std::string(what) + " references vertex " + std::to_string(std::size_t(i) + 1) +
+                    " but there are only " + std::to_string(n) + " vertices");
+  };
+  check(g.faces, "face");
+  check(g.lines, "line");
+  check(g.points, "point");
+}
+
+/// Every face edge (consecutive corners, wrapping), sorted; an edge used by k
+/// face sides appears k times. Repeated-vertex (zero-length) sides are skipped.
+std::vector<std::uint64_t> sorted_face_edges(const Garment& g) {
+  std::vector<std::uint64_t> keys;
+  keys.reserve(g.faces.indices.size());
+  for (std::size_t f = 0; f < g.faces.rows(); ++f) {
+    const auto row = g.faces.row(f);
+    for (std::size_t k = 0; k < row.size(); ++k) {
+      const Index a = row[k], b = row[(k + 1) % row.size()];
+      if (a != b) keys.push_back(edge_key(a, b));
+    }
+  }
+  // Equal keys are identical, so the sorted result is the same for any thread count.
+  tbb::parallel_sort(keys.begin(), keys.end());
+  return keys;
+}
+
+struct UnionFind {
+  std::vector<Index> parent;
+  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), Index(0)); }
+  Index find(Index x) {
+    while (parent[x] != x) {
+      parent[x] = parent[parent[x]];
+      x = parent[x];
+    }
+    return x;
+  }
+  void unite(Index a, Index b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+};
+
+std::vector<std::vector<Index>> loops_from_edges(const Garment& g, const std::vector<std::uint64_t>& keys);
+
+}  // namespace
+
+TopologyStats topology_stats(const Garment& g) {
+  check_indices(g);
+  TopologyStats s;
+  s.vertices = g.vertex_count();
+  s.faces = g.faces.rows();
+  s.lines = g.lines.rows();
+  s.points = g.points.rows();
+
+  const std::vector<std::uint64_t> keys = sorted_face_edges(g);
+  for (std::size_t i = 0; i < keys.size();) {
+    std::size_t j = i + 1;
+    while (j < keys.size() && keys[j] == keys[i]) ++j;
+    ++s.edges;
+    if (j - i == 1) ++s.boundary_edges;
+    if (j - i >= 3) ++s.non_manifold_edges;
+    i = j;
+  }
+
+  UnionFind uf(s.vertices);
+  std::vector<std::uint8_t> used(s.vertices, 0);
+  for (const Csr* csr : {&g.faces, &g.lines})
+    for (std::size_t r = 0; r < csr->rows(); ++r) {
+      const auto row = csr->row(r);
+      for (Index v : row) {
+        used[v] = 1;
+        uf.unite(row[0], v);
+      }
+    }
+  // `p v1 v2 ...` lists separate points (OBJ spec): each vertex stands alone.
+  for (Index v : g.points.indices) used[v] = 1;
+  for (std::size_t v = 0; v < s.vertices; ++v) {
+    if (!used[v]) ++s.unreferenced_vertices;
+    else if (uf.find(static_cast<Index>(v)) == v) ++s.components;
+  }
+  s.boundary_loops = loops_from_edges(g, keys).size();
+  return s;
+}
+
+std::vector<std::vector<Index>> boundary_loops(const Garment& g) {
+  check_indices(g);
+  return loops_from_edges(g, sorted_face_edges(g));
+}
+
+namespace {
+
+std::vector<std::vector<Index>> loops_from_edges(const Garment& g, const std::vector<std::uint64_t>& keys) {
+  // Boundary edges (used once), in key order.
+  std::vector<std::uint64_t> boundary;
+  for (std::size_t i = 0; i < keys.size();) {
+    std::size_t j = i + 1;
+    while (j < keys.size() && keys[j] == keys[i]) ++j;
+    if (j - i == 1) boundary.push_back(keys[i]);
+    i = j;
+  }
+  if (boundary.empty()) return {};
+
+  // Boundary edges at each vertex (CSR, edge ids ascending), to chain them.
+  const std::size_t n = g.vertex_count();
+  Csr at;
+  at.offsets.assign(n + 1, 0);
+  for (std::uint64_t k : boundary) {
+    ++at.offsets[key_lo(k) + 1];
+    ++at.offsets[key_hi(k) + 1];
+  }
+  for (std::size_t v = 0; v < n; ++v) at.offsets[v + 1] += at.offsets[v];
+  at.indices.resize(at.offsets[n]);
+  {
+    std::vector<Index> fill(at.offsets.begin(), at.offsets.end() - 1);
+    for (std::size_t e = 0; e < boundary.size(); ++e) {
+      at.indices[fill[key_lo(boundary[e])]++] = static_cast<Index>(e);
+      at.indices[fill[key_hi(boundary[e])]++] = static_cast<Index>(e);
+    }
+  }
+
+  // The direction a face gives each boundary edge, so loops follow the faces'
+  // orientation where they are consistent.
+  std::vector<std::uint8_t> forward(boundary.size(), 1);  // lo -> hi
+  for (std::size_t f = 0; f < g.faces.rows(); ++f) {
+    const auto row = g.faces.row(f);
+    for (std::size_t k = 0; k < row.size(); ++k) {
+      const Index a = row[k], b = row[(k + 1) % row.size()];
+      if (a == b) continue;
+      const auto it = std::lower_bound(boundary.begin(), boundary.end(), edge_key(a, b));
+      if (it != boundary.end() && *it == edge_key(a, b)) forward[std::size_t(it - boundary.begin())] = a < b;
+    }
+  }
+
+  // Walk from each unused edge; at a vertex with several unused boundary edges
+  // take the one with the smallest id. Coming back to a vertex already on the
+  // chain closes a loop there (so loops are simple cycles); a chain that ends
+  // without closing is dropped. Every edge is used once: the walk terminates.
+  std::vector<std::uint8_t> done(boundary.size(), 0);
+  std::vector<std::int64_t> pos_in_chain(n, -1);
+  std::vector<std::vector<Index>> loops;
+  std::vector<Index> chain;
+  for (std::size_t start = 0; start < boundary.size(); ++start) {
+    if (done[start]) continue;
+    done[start] = 1;
+    const Index a = key_lo(boundary[start]), b = key_hi(boundary[start]);
+    chain.assign({forward[start] ? a : b});
+    Index cur = forward[start] ? b : a;
+    pos_in_chain[chain[0]] = 0;
+    for (;;) {
+      const std::int64_t seen = pos_in_chain[cur];
+      if (seen >= 0) {
+        loops.emplace_back(chain.begin() + seen, chain.end());
+        for (auto it = chain.begin() + seen + 1; it != chain.end(); ++it) pos_in_chain[*it] = -1;
+        chain.resize(static_cast<std::size_t>(seen) + 1);
+      } else {
+        pos_in_chain[cur] = static_cast<std::int64_t>(chain.size());
+        chain.push_back(cur);
+      }
+      Index next_edge = Index(-1);
+      for (Index e : at.row(cur))
+        if (!done[e]) {
+          next_edge = e;
+          break;
+        }
+      if (next_edge == Index(-1)) break;
+      done[next_edge] = 1;
+      cur = key_lo(boundary[next_edge]) == cur ? key_hi(boundary[next_edge]) : key_lo(boundary[next_edge]);
+    }
+    for (Index v : chain) pos_in_chain[v] = -1;
+  }
+  // Each loop starts at its smallest vertex (direction kept), so the result
+  // does not depend on which edge the walk happened to start from.
+  for (auto& loop : loops) std::rotate(loop.begin(), std::min_element(loop.begin(), loop.end()), loop.end());
+  return loops;
+}
+
+}  // namespace
+
+}  // namespace refit

@@ -1,0 +1,638 @@
+#include <refit/io/obj_garment.hpp>
+
+#include <refit/core/error.hpp>
+#include <refit/core/parallel.hpp>
+#include <refit/io/atomic_file.hpp>
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <optional>
+#include <utility>
+
+#include <sys/stat.h>
+
+namespace refit {
+namespace {
+
+// Chunks of whole lines are parsed and formatted independently. The chunk
+// boundaries depend only on the text, so results do not depend on the threads.
+constexpr std::size_t kChunkBytes = std::size_t(1) << 18;
+constexpr std::size_t kMaxWarnings = 20;
+
+struct ParseFailure {
+  std::size_t line;  // 1-based, local to the chunk
+  std::string message;
+};
+
+bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+/// Splits one line (without its '\n') into whitespace-separated tokens; a token
+/// starting with '#' ends the line (trailing comments).
+struct Tokens {
+  const char* p;
+  const char* end;
+  std::string_view next() {
+    while (p < end && is_blank(*p)) ++p;
+    if (p == end || *p == '#') return {};
+    const char* s = p;
+    while (p < end && !is_blank(*p)) ++p;
+    return {s, static_cast<std::size_t>(p - s)};
+  }
+};
+
+enum class Kind { kBlank, kV, kVt, kVn, kF, kL, kP, kKnown, kUnknown };
+
+Kind classify(std::string_view kw) {
+  if (kw.empty()) return Kind::kBlank;
+  if (kw == "v") return Kind::kV;
+  if (kw == "vt") return Kind::kVt;
+  if (kw == "vn") return Kind::kVn;
+  if (kw == "f") return Kind::kF;
+  if (kw == "l") return Kind::kL;
+  if (kw == "p") return Kind::kP;
+  if (kw == "g" || kw == "o" || kw == "s" || kw == "usemtl" || kw == "mtllib") return Kind::kKnown;
+  return Kind::kUnknown;
+}
+
+template <class F>
+void for_each_line(const char* b, const char* e, F&& f) {
+  while (b < e) {
+    const char* nl = static_cast<const char*>(std::memchr(b, '\n', static_cast<std::size_t>(e - b)));
+    const char* le = nl ? nl : e;
+    f(b, le);
+    b = nl ? nl + 1 : e;
+  }
+}
+
+std::string quoted(std::string_view s) {
+  if (s.size() > 40) s = s.substr(0, 40);
+  std::string out(1, '\'');
+  out.append(s);
+  out.push_back('\'');
+  return out;
+}
+
+struct Chunk {
+  // pass 1
+  std::size_t lines = 0, nv = 0, nvt = 0, nvn = 0, nf = 0;
+  // pass 2 (positions, normals and their spans go straight into the result)
+  std::vector<Index> face_sizes, face_v, face_n, line_sizes, line_v, point_sizes, point_v;
+  bool any_normal = false;
+  std::vector<std::pair<std::size_t, std::string>> warnings;  // local line, text (the first few)
+  std::size_t unknown = 0;                                      // unknown statements
+  std::optional<ParseFailure> failure;
+};
+
+struct Totals {
+  std::size_t v = 0, vt = 0, vn = 0;
+};
+
+/// Where pass 2 writes `v` and `vn` data, indexed by their global number.
+struct Sink {
+  Points& positions;
+  Points& normals;
+  std::vector<ObjSource::Span>& vspans;
+  std::vector<ObjSource::Span>& nspans;
+};
+
+class ChunkParser {
+ public:
+  ChunkParser(const std::string& text, Chunk& out, const Sink& sink, Totals before, Totals totals)
+      : text_(text), out_(out), sink_(sink), cur_(before), totals_(totals) {}
+
+  void parse(std::size_t begin, std::size_t end) {
+    const char* base = text_.data();
+    out_.face_sizes.reserve(out_.nf);
+    out_.face_v.reserve(out_.nf * 4);
+    try {
+      for_each_line(base + begin, base + end, [&](const char* b, const char* e) {
+        ++line_;
+        statement(b, e);
+      });
+    } catch (const ParseFailure& f) {
+      out_.failure = f;
+    }
+  }
+
+ private:
+  [[noreturn]] void fail(std::string message) const { throw ParseFailure{line_, std::move(message)}; }
+
+  double number(std::string_view tok, std::string_view kw) const {
+    const char* b = tok.data();
+    const char* e = b + tok.size();
+    if (b < e && *b == '+') ++b;
+    double x = 0;
+    const auto [ptr, ec] = std::from_chars(b, e, x);
+    if (ec == std::errc::result_out_of_range) fail("number " + quoted(tok) + " out of range in '" + std::string(kw) + "'");
+    if (ec != std::errc() || ptr != e || b == e)
+      fail("malformed number " + quoted(tok) + " in '" + std::string(kw) + "' statement");
+    if (!std::isfinite(x)) fail("non-finite coordinate " + quoted(tok) + " in '" + std::string(kw) + "' statement");
+    return x;
+  }
+
+  // Reads up to `max` numbers; returns how many, with the byte span of the first three.
+  std::size_t numbers(Tokens& t, std::string_view kw, double* values, std::size_t max,
+                      ObjSource::Span* span) const {
+    std::size_t count = 0;
+    for (std::string_view tok = t.next(); !tok.empty(); tok = t.next()) {
+      if (count == max) fail("too many numbers in '" + std::string(kw) + "' statement");
+      values[count] = number(tok, kw);
+      if (span && count == 0) span->begin = static_cast<std::size_t>(tok.data() - text_.data());
+      if (span && count == 2) span->end = static_cast<std::size_t>(tok.data() + tok.size() - text_.data());
+      ++count;
+    }
+    return count;
+  }
+
+  // Turns a 1-based (or negative, relative) OBJ index into a 0-based one.
+  Index resolve(long long raw, std::size_t cur, std::size_t total, const char* what) const {
+    if (raw == 0) fail(std::string(what) + " index 0 is invalid (OBJ indices start at 1)");
+    if (raw > 0) {
+      if (static_cast<unsigned long long>(raw) > total)
+        fail(std::string(what) + " index " + std::to_string(raw) + " out of range (the file has " +
+             std::to_string(total) + " " + what + (total == 1 ? "" : "s") + ")");
+      return static_cast<Index>(raw - 1);
+    }
+    if (static_cast<unsigned long long>(-raw) > cur)
+      fail("relative " + std::string(what) + " index " + std::to_string(raw) + " out of range (only " +
+           std::to_string(cur) + " " + what + (cur == 1 ? "" : "s") + " before this line)");
+    return static_cast<Index>(static_cast<long long>(cur) + raw);
+  }
+
+  static bool integer(const char*& p, const char* e, long long& v) {
+    if (p < e && *p == '+') ++p;
+    const auto [ptr, ec] = std::from_chars(p, e, v);
+    if (ec != std::errc() || ptr == p) return false;
+    p = ptr;
+    return true;
+  }
+
+  // One corner token: v, v/vt, v//vn or v/vt/vn (`allow_normal` false for `l`, `p`).
+  void corner(std::string_view tok, std::string_view kw, bool allow_vt, bool allow_normal, Index& v,
+              Index& vn, bool& has_vn) const {
+    const char* p = tok.data();
+    const char* e = p + tok.size();
+    long long iv = 0, ivt = 0, ivn = 0;
+    bool has_vt = false;
+    has_vn = false;
+    bool ok = integer(p, e, iv);
+    if (ok && p < e) {
+      ok = *p++ == '/';
+      if (ok && p < e && *p == '/') {
+        ++p;
+        ok = integer(p, e, ivn);
+        has_vn = true;
+      } else if (ok) {
+        ok = integer(p, e, ivt);
+        has_vt = true;
+        if (ok && p < e) {
+          ok = *p++ == '/' && integer(p, e, ivn);
+          has_vn = true;
+        }
+      }
+    }
+    if (!ok || p != e || (has_vt && !allow_vt) || (has_vn && !allow_normal))
+      fail("malformed index " + quoted(tok) + " in '" + std::string(kw) + "' statement");
+    v = resolve(iv, cur_.v, totals_.v, "vertex");
+    if (has_vt) resolve(ivt, cur_.vt, totals_.vt, "texture coordinate");
+    if (has_vn) vn = resolve(ivn, cur_.vn, totals_.vn, "normal");
+  }
+
+  void statement(const char* b, const char* e) {
+    Tokens t{b, e};
+    const std::string_view kw = t.next();
+    double values[7];
+    switch (classify(kw)) {
+      case Kind::kBlank:
+      case Kind::kKnown:
+        return;
+      case Kind::kUnknown:
+        if (out_.unknown++ < kMaxWarnings)
+          out_.warnings.emplace_back(line_, "unknown statement " + quoted(kw) + " kept verbatim");
+        return;
+      case Kind::kV: {
+        ObjSource::Span span;
+        const std::size_t n = numbers(t, kw, values, 7, &span);
+        if (n < 3) fail("'v' needs 3 coordinates, found " + std::to_string(n));
+        for (int k = 0; k < 3; ++k) sink_.positions(static_cast<Eigen::Index>(cur_.v), k) = values[k];
+        sink_.vspans[cur_.v] = span;
+        ++cur_.v;
+        return;
+      }
+      case Kind::kVt: {
+        const std::size_t n = numbers(t, kw, values, 3, nullptr);
+        if (n < 1) fail("'vt' needs 1 to 3 numbers, found none");
+        ++cur_.vt;
+        return;
+      }
+      case Kind::kVn: {
+        ObjSource::Span span;
+        const std::size_t n = numbers(t, kw, values, 3, &span);
+        if (n != 3) fail("'vn' needs 3 numbers, found " + std::to_string(n));
+        for (int k = 0; k < 3; ++k) sink_.normals(static_cast<Eigen::Index>(cur_.vn), k) = values[k];
+        sink_.nspans[cur_.vn] = span;
+        ++cur_.vn;
+        return;
+      }
+      case Kind::kF: {
+        std::size_t n = 0;
+        for (std::string_view tok = t.next(); !tok.empty(); tok = t.next(), ++n) {
+          Index v = 0, vn = ObjSource::kNoNormal;
+          bool has_vn = false;
+          corner(tok, kw, true, true, v, vn, has_vn);
+          out_.face_v.push_back(v);
+          if (has_vn && !out_.any_normal) {
+            out_.any_normal = true;
+            out_.face_n.assign(out_.face_v.size() - 1, ObjSource::kNoNormal);
+          }
+          if (out_.any_normal) out_.face_n.push_back(vn);
+        }
+        if (n < 3) fail("face with " + std::to_string(n) + " vertices (needs at least 3)");
+        out_.face_sizes.push_back(static_cast<Index>(n));
+        return;
+      }
+      case Kind::kL:
+      case Kind::kP: {
+        const bool line = kw == "l";
+        auto& indices = line ? out_.line_v : out_.point_v;
+        std::size_t n = 0;
+        for (std::string_view tok = t.next(); !tok.empty(); tok = t.next(), ++n) {
+          Index v = 0, vn = 0;
+          bool has_vn = false;
+          corner(tok, kw, line, false, v, vn, has_vn);
+          indices.push_back(v);
+        }
+        if (line && n < 2) fail("'l' with " + std::to_string(n) + " vertices (needs at least 2)");
+        if (!line && n < 1) fail("'p' with no vertex");
+        (line ? out_.line_sizes : out_.point_sizes).push_back(static_cast<Index>(n));
+        return;
+      }
+    }
+  }
+
+  const std::string& text_;
+  Chunk& out_;
+  const Sink& sink_;
+  Totals cur_, totals_;
+  std::size_t line_ = 0;
+};
+
+// Pass 1: lines and v/vt/vn counts of a chunk, so that pass 2 knows every
+// chunk's starting counts and can resolve relative indices and ranges at once.
+void count_chunk(const std::string& text, std::size_t begin, std::size_t end, Chunk& c) {
+  for_each_line(text.data() + begin, text.data() + end, [&](const char* b, const char* e) {
+    ++c.lines;
+    while (b < e && is_blank(*b)) ++b;
+    if (e - b < 2) return;
+    if (*b == 'f' && is_blank(b[1])) ++c.nf;
+    if (*b != 'v') return;
+    if (is_blank(b[1])) {
+      ++c.nv;
+    } else if (e - b >= 3 && is_blank(b[2])) {
+      if (b[1] == 't') ++c.nvt;
+      if (b[1] == 'n') ++c.nvn;
+    }
+  });
+}
+
+void fill_csr(Csr& csr, std::vector<Chunk>& chunks, std::vector<Index> Chunk::*sizes,
+              std::vector<Index> Chunk::*indices) {
+  std::vector<std::size_t> row0(chunks.size() + 1, 0), idx0(chunks.size() + 1, 0);
+  for (std::size_t c = 0; c < chunks.size(); ++c) {
+    row0[c + 1] = row0[c] + (chunks[c].*sizes).size();
+    idx0[c + 1] = idx0[c] + (chunks[c].*indices).size();
+  }
+  csr.offsets.assign(row0.back() + 1, 0);
+  csr.indices.resize(idx0.back());
+  parallel_for(0, chunks.size(), 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t c = b; c < e; ++c) {
+      const auto& s = chunks[c].*sizes;
+      const auto& ix = chunks[c].*indices;
+      std::size_t off = idx0[c];
+      for (std::size_t r = 0; r < s.size(); ++r) {
+        off += s[r];
+        csr.offsets[row0[c] + r + 1] = static_cast<Index>(off);
+      }
+      std::copy(ix.begin(), ix.end(), csr.indices.begin() + static_cast<std::ptrdiff_t>(idx0[c]));
+    }
+  });
+}
+
+Garment parse_owned(std::string text, const std::string& file) {
+  const std::size_t n = text.size();
+  auto src = std::make_shared<ObjSource>();
+  src->file = file;
+  std::vector<std::size_t>& bounds = src->chunk_begin;
+  bounds.assign(1, 0);
+  while (bounds.back() < n) {
+    std::size_t b = bounds.back() + kChunkBytes;
+    if (b < n) {
+      const void* nl = std::memchr(text.data() + b, '\n', n - b);
+      b = nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - text.data()) + 1 : n;
+    }
+    bounds.push_back(std::min(b, n));
+  }
+  const std::size_t nc = bounds.size() - 1;
+  std::vector<Chunk> chunks(nc);
+  parallel_for(0, nc, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t c = b; c < e; ++c) count_chunk(text, bounds[c], bounds[c + 1], chunks[c]);
+  });
+  std::vector<Totals> before(nc + 1);
+  std::vector<std::size_t> line0(nc + 1, 0);
+  for (std::size_t c = 0; c < nc; ++c) {
+    before[c + 1] = {before[c].v + chunks[c].nv, before[c].vt + chunks[c].nvt, before[c].vn + chunks[c].nvn};
+    line0[c + 1] = line0[c] + chunks[c].lines;
+  }
+  const Totals totals = before[nc];
+  Garment g;
+  g.positions.resize(static_cast<Eigen::Index>(totals.v), 3);
+  src->normals.resize(static_cast<Eigen::Index>(totals.vn), 3);
+  src->vertex_spans.resize(totals.v);
+  src->normal_spans.resize(totals.vn);
+  const Sink sink{g.positions, src->normals, src->vertex_spans, src->normal_spans};
+  parallel_for(0, nc, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t c = b; c < e; ++c)
+      ChunkParser(text, chunks[c], sink, before[c], totals).parse(bounds[c], bounds[c + 1]);
+  });
+  for (std::size_t c = 0; c < nc; ++c)
+    if (chunks[c].failure) throw input_error(file, chunks[c].failure->message, line0[c] + chunks[c].failure->line);
+  if (totals.v == 0) throw input_error(file, "empty garment: the file has no vertices ('v' lines)");
+
+  src->positions = g.positions;
+  fill_csr(g.faces, chunks, &Chunk::face_sizes, &Chunk::face_v);
+  fill_csr(g.lines, chunks, &Chunk::line_sizes, &Chunk::line_v);
+  fill_csr(g.points, chunks, &Chunk::point_sizes, &Chunk::point_v);
+
+  const bool any_normal = std::any_of(chunks.begin(), chunks.end(), [](const Chunk& c) { return c.any_normal; });
+  if (any_normal) {
+    src->corner_normals.reserve(g.faces.indices.size());
+    for (const Chunk& c : chunks) {
+      if (c.any_normal)
+        src->corner_normals.insert(src->corner_normals.end(), c.face_n.begin(), c.face_n.end());
+      else
+        src->corner_normals.insert(src->corner_normals.end(), c.face_v.size(), ObjSource::kNoNormal);
+    }
+  }
+  src->face_corner_count = g.faces.indices.size();
+  src->chunk_first_vertex.resize(nc + 1);
+  src->chunk_first_normal.resize(nc + 1);
+  for (std::size_t c = 0; c <= nc; ++c) {
+    src->chunk_first_vertex[c] = before[c].v;
+    src->chunk_first_normal[c] = before[c].vn;
+  }
+  src->texcoords = totals.vt;
+  std::size_t unknown = 0;
+  for (std::size_t c = 0; c < nc; ++c) {
+    unknown += chunks[c].unknown;
+    for (const auto& [line, w] : chunks[c].warnings)
+      if (src->warnings.size() < kMaxWarnings)
+        src->warnings.push_back(file + ":" + std::to_string(line0[c] + line) + ": " + w);
+  }
+  if (unknown > src->warnings.size())
+    src->warnings.push_back(file + ": " + std::to_string(unknown - src->warnings.size()) +
+                            " more unknown statements kept verbatim");
+  const std::size_t first_nl = text.find('\n');
+  src->crlf = first_nl != std::string::npos && first_nl > 0 && text[first_nl - 1] == '\r';
+  chunks.clear();
+  src->text = std::move(text);
+  g.source = std::move(src);
+  return g;
+}
+
+// ---- writing ---------------------------------------------------------------
+
+void append_number(std::string& out, double x) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, x);
+  out.append(buf, r.ptr);
+}
+
+void append_index(std::string& out, std::size_t i) {
+  char buf[24];
+  const auto r = std::to_chars(buf, buf + sizeof buf, i);
+  out.append(buf, r.ptr);
+}
+
+void append_xyz(std::string& out, double x, double y, double z) {
+  append_number(out, x);
+  out.push_back(' ');
+  append_number(out, y);
+  out.push_back(' ');
+  append_number(out, z);
+}
+
+bool same_bits(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); }
+
+void check_finite(const Points& p, const std::string& where) {
+  const std::size_t n = static_cast<std::size_t>(p.rows());
+  constexpr std::size_t kGrain = 1 << 16;
+  const std::size_t blocks = (n + kGrain - 1) / kGrain;
+  std::vector<std::size_t> first_bad(blocks, n);
+  parallel_for(0, blocks, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k)
+      for (std::size_t i = k * kGrain; i < std::min(n, (k + 1) * kGrain); ++i) {
+        const auto ii = static_cast<Eigen::Index>(i);
+        if (!std::isfinite(p(ii, 0)) || !std::isfinite(p(ii, 1)) || !std::isfinite(p(ii, 2))) {
+          first_bad[k] = i;
+          break;
+        }
+      }
+  });
+  for (std::size_t i : first_bad)
+    if (i < n) throw input_error(where, "vertex " + std::to_string(i + 1) + " has a non-finite coordinate; nothing written");
+}
+
+std::string join(std::vector<std::string>& parts) {
+  std::size_t total = 0;
+  for (const auto& s : parts) total += s.size();
+  std::string out;
+  out.reserve(total);
+  for (auto& s : parts) {
+    out += s;
+    std::string().swap(s);
+  }
+  return out;
+}
+
+// The output comes in parts (one per chunk), so a writer can stream them
+// without first joining them into one more copy of the file.
+using Parts = std::vector<std::string>;
+
+// A plain OBJ for garments that come from no file.
+Parts format_plain(const Garment& g) {
+  const std::size_t nv = g.vertex_count();
+  constexpr std::size_t kGrain = 1 << 15;
+  const auto blocks = [](std::size_t n) { return (n + kGrain - 1) / kGrain; };
+  const std::size_t bv = blocks(nv), bf = blocks(g.faces.rows()), bl = blocks(g.lines.rows()), bp = blocks(g.points.rows());
+  std::vector<std::string> parts(bv + bf + bl + bp);
+  const auto csr_part = [&](const Csr& csr, const char* kw, std::size_t k, std::string& out) {
+    for (std::size_t r = k * kGrain; r < std::min(csr.rows(), (k + 1) * kGrain); ++r) {
+      out += kw;
+      for (Index i : csr.row(r)) {
+        out.push_back(' ');
+        append_index(out, std::size_t(i) + 1);
+      }
+      out.push_back('\n');
+    }
+  };
+  parallel_for(0, parts.size(), 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) {
+      std::string& out = parts[k];
+      if (k < bv) {
+        for (std::size_t i = k * kGrain; i < std::min(nv, (k + 1) * kGrain); ++i) {
+          const auto ii = static_cast<Eigen::Index>(i);
+          out += "v ";
+          append_xyz(out, g.positions(ii, 0), g.positions(ii, 1), g.positions(ii, 2));
+          out.push_back('\n');
+        }
+      } else if (k < bv + bf) {
+        csr_part(g.faces, "f", k - bv, out);
+      } else if (k < bv + bf + bl) {
+        csr_part(g.lines, "l", k - bv - bf, out);
+      } else {
+        csr_part(g.points, "p", k - bv - bf - bl, out);
+      }
+    }
+  });
+  return parts;
+}
+
+// Each referenced normal: the normalised sum of the area-weighted (Newell)
+// normals of the faces whose corners use it. Sequential scatter in face order,
+// so the sums are the same whatever the thread count.
+std::vector<std::uint8_t> recompute_normals(const Garment& g, const ObjSource& s, Points& normals,
+                                            ObjWriteReport& report) {
+  const std::size_t nn = static_cast<std::size_t>(s.normals.rows());
+  std::vector<std::uint8_t> recomputed(nn, 0);
+  normals = Points::Zero(static_cast<Eigen::Index>(nn), 3);
+  std::vector<std::uint8_t> used(nn, 0);
+  for (std::size_t f = 0; f < g.faces.rows(); ++f) {
+    const auto row = g.faces.row(f);
+    Vec3 n = Vec3::Zero();
+    for (std::size_t k = 0; k < row.size(); ++k) {
+      const Vec3 a = row3(g.positions, row[k]);
+      const Vec3 b = row3(g.positions, row[(k + 1) % row.size()]);
+      n += a.cross(b);
+    }
+    for (std::size_t k = g.faces.offsets[f]; k < g.faces.offsets[f + 1]; ++k) {
+      const Index ni = s.corner_normals[k];
+      if (ni == ObjSource::kNoNormal) continue;
+      normals.row(ni) += n.transpose();
+      used[ni] = 1;
+    }
+  }
+  std::size_t degenerate = 0;
+  for (std::size_t i = 0; i < nn; ++i) {
+    if (!used[i]) continue;
+    const double len = normals.row(static_cast<Eigen::Index>(i)).norm();
+    if (len > 0 && std::isfinite(len)) {
+      normals.row(static_cast<Eigen::Index>(i)) /= len;
+      recomputed[i] = 1;
+      ++report.normals_recomputed;
+    } else {
+      ++degenerate;
+    }
+  }
+  if (degenerate > 0)
+    report.warnings.push_back(std::to_string(degenerate) +
+                              " normals belong only to zero-area faces and were kept as they were");
+  return recomputed;
+}
+
+Parts format_source(const Garment& g, const ObjSource& s, ObjWriteReport& report, const std::string& where) {
+  if (g.vertex_count() != s.vertex_spans.size())
+    throw input_error(where, "the garment has " + std::to_string(g.vertex_count()) + " vertices but its source " +
+                                 s.file + " has " + std::to_string(s.vertex_spans.size()) +
+                                 "; it cannot be written back line for line");
+  if (g.faces.indices.size() != s.face_corner_count)
+    throw input_error(where, "the garment's faces differ from its source " + s.file +
+                                 "; it cannot be written back line for line");
+  const std::size_t nv = g.vertex_count();
+  // Unmoved vertices keep their original text, so an unchanged garment is
+  // written back byte for byte.
+  std::vector<std::uint8_t> moved(nv, 0);
+  const std::size_t moved_count = deterministic_sum<std::size_t>(0, nv, 1 << 15, 0, [&](std::size_t i) -> std::size_t {
+    const auto ii = static_cast<Eigen::Index>(i);
+    bool m = false;
+    for (int k = 0; k < 3; ++k) m |= !same_bits(g.positions(ii, k), s.positions(ii, k));
+    moved[i] = m;
+    return m ? 1 : 0;
+  });
+  Points normals;
+  std::vector<std::uint8_t> recomputed;
+  if (moved_count > 0 && !s.corner_normals.empty()) recomputed = recompute_normals(g, s, normals, report);
+
+  const std::size_t nc = s.chunk_begin.size() - 1;
+  std::vector<std::string> parts(nc);
+  parallel_for(0, nc, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t c = b; c < e; ++c) {
+      std::string& out = parts[c];
+      std::size_t pos = s.chunk_begin[c];
+      const std::size_t end = s.chunk_begin[c + 1];
+      out.reserve(end - pos + (end - pos) / 4);
+      std::size_t vi = s.chunk_first_vertex[c], ni = s.chunk_first_normal[c];
+      const std::size_t vend = s.chunk_first_vertex[c + 1], nend = s.chunk_first_normal[c + 1];
+      while (vi < vend || ni < nend) {
+        const bool vertex = ni >= nend || (vi < vend && s.vertex_spans[vi].begin < s.normal_spans[ni].begin);
+        const std::size_t i = vertex ? vi++ : ni++;
+        if (vertex ? !moved[i] : (recomputed.empty() || !recomputed[i])) continue;
+        const ObjSource::Span sp = vertex ? s.vertex_spans[i] : s.normal_spans[i];
+        const Points& p = vertex ? g.positions : normals;
+        const auto ii = static_cast<Eigen::Index>(i);
+        out.append(s.text, pos, sp.begin - pos);
+        append_xyz(out, p(ii, 0), p(ii, 1), p(ii, 2));
+        pos = sp.end;
+      }
+      out.append(s.text, pos, end - pos);
+    }
+  });
+  return parts;
+}
+
+Parts format_impl(const Garment& g, ObjWriteReport& report, const std::string& where) {
+  check_finite(g.positions, where);
+  return g.source ? format_source(g, *g.source, report, where) : format_plain(g);
+}
+
+}  // namespace
+
+Garment parse_garment_obj(std::string_view text, const std::string& file_for_errors) {
+  return parse_owned(std::string(text), file_for_errors);
+}
+
+Garment read_garment_obj(const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) throw input_error(path, std::string("cannot open: ") + std::strerror(errno));
+  struct stat st {};
+  if (::fstat(::fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
+    std::fclose(f);
+    throw input_error(path, "cannot read: not a regular file");
+  }
+  std::string text(static_cast<std::size_t>(st.st_size), '\0');
+  const bool ok = std::fread(text.data(), 1, text.size(), f) == text.size();
+  std::fclose(f);
+  if (!ok) throw input_error(path, "cannot read the whole file");
+  return parse_owned(std::move(text), path);
+}
+
+std::string format_garment_obj(const Garment& g, ObjWriteReport* report) {
+  ObjWriteReport local;
+  Parts parts = format_impl(g, report ? *report : local, g.source ? g.source->file : std::string("<garment>"));
+  return join(parts);
+}
+
+ObjWriteReport write_garment_obj(const std::string& path, const Garment& g) {
+  ObjWriteReport report;
+  const Parts parts = format_impl(g, report, path);
+  write_file_atomically(path, [&](std::ostream& out) {
+    for (const std::string& p : parts) out.write(p.data(), static_cast<std::streamsize>(p.size()));
+  });
+  return report;
+}
+
+}  // namespace refit

@@ -1,0 +1,172 @@
+// Topology statistics and boundary loops on small hand-made garments, including
+// the non-manifold cases CAD files contain.
+#include <refit/core/error.hpp>
+#include <refit/core/topology.hpp>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <initializer_list>
+#include <set>
+#include <utility>
+
+namespace refit {
+namespace {
+
+Garment make(std::size_t vertices, std::initializer_list<std::initializer_list<Index>> faces,
+             std::initializer_list<std::initializer_list<Index>> lines = {},
+             std::initializer_list<std::initializer_list<Index>> points = {}) {
+  Garment g;
+  g.positions = Points::Zero(static_cast<Eigen::Index>(vertices), 3);
+  for (std::size_t i = 0; i < vertices; ++i) g.positions(static_cast<Eigen::Index>(i), 0) = double(i);
+  for (auto f : faces) g.faces.push_row(std::vector<Index>(f));
+  for (auto l : lines) g.lines.push_row(std::vector<Index>(l));
+  for (auto p : points) g.points.push_row(std::vector<Index>(p));
+  return g;
+}
+
+// Each loop is a closed cycle of boundary edges; no boundary edge is used twice.
+void expect_valid_loops(const Garment& g, const std::vector<std::vector<Index>>& loops) {
+  std::multiset<std::pair<Index, Index>> face_edges;
+  for (std::size_t f = 0; f < g.faces.rows(); ++f) {
+    const auto r = g.faces.row(f);
+    for (std::size_t k = 0; k < r.size(); ++k)
+      face_edges.insert(std::minmax(r[k], r[(k + 1) % r.size()]));
+  }
+  std::set<std::pair<Index, Index>> used;
+  for (const auto& loop : loops) {
+    ASSERT_GE(loop.size(), 2u);
+    for (std::size_t k = 0; k < loop.size(); ++k) {
+      const auto e = std::minmax(loop[k], loop[(k + 1) % loop.size()]);
+      EXPECT_EQ(face_edges.count(e), 1u) << "loop edge " << e.first << "-" << e.second << " is not a boundary edge";
+      EXPECT_TRUE(used.insert(e).second) << "boundary edge used twice";
+    }
+  }
+}
+
+TEST(Topology, ThreeFacesOnOneEdgeIsNonManifold) {
+  const Garment g = make(5, {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}});
+  const TopologyStats s = topology_stats(g);
+  EXPECT_EQ(s.faces, 3u);
+  EXPECT_EQ(s.edges, 7u);
+  EXPECT_EQ(s.non_manifold_edges, 1u);
+  EXPECT_EQ(s.boundary_edges, 6u);
+  EXPECT_EQ(s.components, 1u);
+  EXPECT_EQ(s.unreferenced_vertices, 0u);
+  // Vertices 0 and 1 have three boundary edges each, so the six cannot all be
+  // chained into closed loops: one closed 4-cycle, the open rest (0-4-1) skipped.
+  const auto loops = boundary_loops(g);
+  expect_valid_loops(g, loops);
+  ASSERT_EQ(loops.size(), 1u);
+  EXPECT_EQ(loops[0], (std::vector<Index>{0, 3, 1, 2}));
+  EXPECT_EQ(s.boundary_loops, 1u);
+}
+
+TEST(Topology, HangingLineLoosePointAndUnreferencedVertex) {
+  // Triangle 0-1-2, a hanging line 2-3-4, a loose point 5 and an unreferenced vertex 6.
+  const Garment g = make(7, {{0, 1, 2}}, {{2, 3, 4}}, {{5}});
+  const TopologyStats s = topology_stats(g);
+  EXPECT_EQ(s.vertices, 7u);
+  EXPECT_EQ(s.faces, 1u);
+  EXPECT_EQ(s.lines, 1u);
+  EXPECT_EQ(s.points, 1u);
+  EXPECT_EQ(s.unreferenced_vertices, 1u);
+  EXPECT_EQ(s.edges, 3u);  // line edges are not face edges
+  EXPECT_EQ(s.boundary_edges, 3u);
+  EXPECT_EQ(s.non_manifold_edges, 0u);
+  EXPECT_EQ(s.boundary_loops, 1u);
+  EXPECT_EQ(s.components, 2u);  // triangle + line, and the point
+}
+
+TEST(Topology, EachVertexOfAPointStatementIsItsOwnComponent) {
+  // `p 4 5 6` lists three separate points (OBJ spec); vertex 3 is unreferenced.
+  const Garment g = make(7, {{0, 1, 2}}, {}, {{4, 5, 6}, {2}});
+  const TopologyStats s = topology_stats(g);
+  EXPECT_EQ(s.points, 2u);
+  EXPECT_EQ(s.unreferenced_vertices, 1u);
+  EXPECT_EQ(s.components, 4u);
+}
+
+TEST(Topology, TwoComponents) {
+  const Garment g = make(6, {{0, 1, 2}, {3, 4, 5}});
+  const TopologyStats s = topology_stats(g);
+  EXPECT_EQ(s.components, 2u);
+  EXPECT_EQ(s.boundary_loops, 2u);
+  const auto loops = boundary_loops(g);
+  ASSERT_EQ(loops.size(), 2u);
+  EXPECT_EQ(loops[0], (std::vector<Index>{0, 1, 2}));
+  EXPECT_EQ(loops[1], (std::vector<Index>{3, 4, 5}));
+}
+
+TEST(Topology, QuadStripHasOneLoopInFaceOrder) {
+  // 0 1 2 3 along the bottom, 4 5 6 7 along the top.
+  const Garment g = make(8, {{0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}});
+  const TopologyStats s = topology_stats(g);
+  EXPECT_EQ(s.edges, 10u);
+  EXPECT_EQ(s.boundary_edges, 8u);
+  EXPECT_EQ(s.non_manifold_edges, 0u);
+  EXPECT_EQ(s.components, 1u);
+  const auto loops = boundary_loops(g);
+  ASSERT_EQ(loops.size(), 1u);
+  EXPECT_EQ(loops[0], (std::vector<Index>{0, 1, 2, 3, 7, 6, 5, 4}));
+  EXPECT_EQ(s.boundary_loops, 1u);
+}
+
+TEST(Topology, OpenCylinderHasTwoLoops) {
+  constexpr Index n = 6;  // bottom ring 0..5, top ring 6..11
+  Garment g = make(2 * n, {});
+  for (Index i = 0; i < n; ++i) {
+    const Index j = (i + 1) % n;
+    g.faces.push_row(std::vector<Index>{i, j, j + n, i + n});
+  }
+  const TopologyStats s = topology_stats(g);
+  EXPECT_EQ(s.edges, 3u * n);
+  EXPECT_EQ(s.boundary_edges, 2u * n);
+  EXPECT_EQ(s.boundary_loops, 2u);
+  EXPECT_EQ(s.components, 1u);
+  const auto loops = boundary_loops(g);
+  ASSERT_EQ(loops.size(), 2u);
+  expect_valid_loops(g, loops);
+  EXPECT_EQ(loops[0], (std::vector<Index>{0, 1, 2, 3, 4, 5}));
+  EXPECT_EQ(loops[1], (std::vector<Index>{6, 11, 10, 9, 8, 7}));
+}
+
+TEST(Topology, ClosedCubeHasNoBoundary) {
+  const Garment g = make(8, {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}});
+  const TopologyStats s = topology_stats(g);
+  EXPECT_EQ(s.edges, 12u);
+  EXPECT_EQ(s.boundary_edges, 0u);
+  EXPECT_EQ(s.boundary_loops, 0u);
+  EXPECT_EQ(s.components, 1u);
+}
+
+TEST(Topology, BowTieSplitsIntoTwoSimpleLoops) {
+  // Two triangles sharing only vertex 0: four boundary edges meet there.
+  const Garment g = make(5, {{0, 1, 2}, {0, 3, 4}});
+  const auto loops = boundary_loops(g);
+  expect_valid_loops(g, loops);
+  ASSERT_EQ(loops.size(), 2u);
+  EXPECT_EQ(loops[0].size(), 3u);
+  EXPECT_EQ(loops[1].size(), 3u);
+  EXPECT_EQ(topology_stats(g).components, 1u);
+}
+
+TEST(Topology, DegenerateFaceWithRepeatedVertexIsKept) {
+  // Face 0-1-1-2 has a repeated vertex: its zero-length side is no edge.
+  const Garment g = make(3, {{0, 1, 1, 2}});
+  const TopologyStats s = topology_stats(g);
+  EXPECT_EQ(s.faces, 1u);
+  EXPECT_EQ(s.edges, 3u);
+  EXPECT_EQ(s.boundary_loops, 1u);
+  EXPECT_EQ(boundary_loops(g)[0], (std::vector<Index>{0, 1, 2}));
+}
+
+TEST(Topology, IndexOutOfRangeThrows) {
+  const Garment g = make(3, {{0, 1, 7}});
+  EXPECT_THROW(topology_stats(g), Error);
+  EXPECT_THROW(boundary_loops(g), Error);
+}
+
+}  // namespace
+}  // namespace refit

@@ -1,0 +1,58 @@
+// `refit inspect FILE.obj`: element counts and topology of a garment (counts,
+// unreferenced vertices, edges, boundary and non-manifold edges, boundary loops,
+// connected components), as `name: value` lines or, with --json, one JSON object.
+#include "command.hpp"
+
+#include <refit/core/topology.hpp>
+#include <refit/io/obj_garment.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace {
+
+struct InspectOptions {
+  std::string file;
+  bool json = false;
+};
+
+const refit::cli::Register reg(
+    "inspect", "Print the element counts and topology of a garment OBJ", [](CLI::App& app) {
+      auto opt = std::make_shared<InspectOptions>();
+      app.add_option("file", opt->file, "Garment OBJ file")->required();
+      app.add_flag("--json", opt->json, "Print one JSON object instead of 'name: value' lines");
+      return [opt]() -> int {
+        const refit::Garment g = refit::read_garment_obj(opt->file);
+        const refit::TopologyStats s = refit::topology_stats(g);
+        const std::vector<std::pair<const char*, std::size_t>> rows = {
+            {"vertices", s.vertices},
+            {"faces", s.faces},
+            {"lines", s.lines},
+            {"points", s.points},
+            {"unreferenced_vertices", s.unreferenced_vertices},
+            {"edges", s.edges},
+            {"boundary_edges", s.boundary_edges},
+            {"non_manifold_edges", s.non_manifold_edges},
+            {"boundary_loops", s.boundary_loops},
+            {"components", s.components},
+        };
+        if (opt->json) {
+          nlohmann::ordered_json j;
+          j["file"] = opt->file;
+          for (const auto& [name, value] : rows) j[name] = value;
+          std::printf("%s\n", j.dump(2).c_str());
+        } else {
+          for (const auto& [name, value] : rows) std::printf("%s: %zu\n", name, value);
+        }
+        if (g.source)
+          for (const std::string& w : g.source->warnings) std::fprintf(stderr, "refit: warning: %s\n", w.c_str());
+        return 0;
+      };
+    });
+
+}  // namespace
