@@ -1,3 +1,4 @@
+#include <refit/body/body_mesh.hpp>
 #include <refit/io/body_io.hpp>
 
 #include <refit/core/error.hpp>
@@ -20,22 +21,6 @@ namespace {
 template <class Corners>
 void fan_split(const Corners& c, std::vector<std::array<Index, 3>>& out) {
   for (std::size_t k = 1; k + 1 < c.size(); ++k) out.push_back({c[0], c[k], c[k + 1]});
-}
-
-// The checks of check_body (body/body_mesh.cpp), kept here so refit_io does not
-// depend on refit_body.
-void validate(const BodyMesh& body) {
-  const std::string& file = body.path;
-  if (body.triangles.empty()) throw input_error(file, "body has no triangles");
-  const Index n = static_cast<Index>(body.vertices.rows());
-  for (Index i = 0; i < n; ++i)
-    if (!body.vertices.row(i).allFinite())
-      throw input_error(file, "vertex " + std::to_string(i + 1) + " is NaN or infinite");
-  for (std::size_t t = 0; t < body.triangles.size(); ++t)
-    for (Index c : body.triangles[t])
-      if (c >= n)
-        throw input_error(file, "triangle " + std::to_string(t + 1) + " uses vertex " + std::to_string(c + 1) +
-                                    " but the body has " + std::to_string(n) + " vertices");
 }
 
 BodyMesh read_obj_body(const std::string& path) {
@@ -89,7 +74,7 @@ BodyMesh read_body(const std::string& path) {
     throw input_error(path, "unknown body format '" + ext + "' (expected .obj, .ply, .off or .stl)");
   body.name = p.stem().string();
   body.path = path;
-  validate(body);
+  check_body(body);
   return body;
 }
 
