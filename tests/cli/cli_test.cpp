@@ -106,6 +106,8 @@ struct BadInput {
   std::string name, file_text, which, expect;  // which: garment, from, to, features
 };
 
+void PrintTo(const BadInput& p, std::ostream* os) { *os << p.name; }
+
 class CliBadInput : public ::testing::TestWithParam<BadInput> {};
 
 TEST_P(CliBadInput, OneClearLineNonZeroExitNoOutput) {

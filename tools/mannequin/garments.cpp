@@ -446,12 +446,19 @@ void make_soup(Garment& g, double spacing) {
       }
     }
   }
+  // Seam faces now use the copies of step 1, which are not in g.positions yet.
+  const auto position = [&](Index i) { return i < nv ? row3(g.positions, i) : extra[i - nv]; };
+  const auto centroid = [&](std::span<const Index> row) {
+    Vec3 c = Vec3::Zero();
+    for (Index i : row) c += position(i);
+    return Vec3(c / static_cast<double>(row.size()));
+  };
   Csr faces;
   std::vector<std::uint8_t> kept(g.positions.rows() + static_cast<Eigen::Index>(extra.size()), 0);
   const double soup_radius = 3.0 * spacing;
   for (std::size_t f = 0; f < nf; ++f) {
     const auto row = g.faces.row(f);
-    if ((face_centroid(g, f) - anchor).norm() > soup_radius || row.size() != 4) {
+    if ((centroid(row) - anchor).norm() > soup_radius || row.size() != 4) {
       faces.push_row(row);
       continue;
     }
@@ -471,7 +478,6 @@ void make_soup(Garment& g, double spacing) {
     }
   }
   g.faces = std::move(faces);
-  const auto position = [&](Index i) { return i < nv ? row3(g.positions, i) : extra[i - nv]; };
 
   // 3. A flap glued on an interior edge on the back right, half way up (away
   // from the planes x = 0 and z = 0 of the dress's profiles): three faces on
@@ -479,11 +485,7 @@ void make_soup(Garment& g, double spacing) {
   {
     const Vec3 target(0.7 * lo.x(), 0.5 * (lo.y() + hi.y()), 0.7 * lo.z());
     std::vector<std::pair<double, std::size_t>> order;
-    for (std::size_t f = 0; f < g.faces.rows(); ++f) {
-      Vec3 c = Vec3::Zero();
-      for (Index i : g.faces.row(f)) c += position(i);
-      order.push_back({(c / static_cast<double>(g.faces.row_size(f)) - target).squaredNorm(), f});
-    }
+    for (std::size_t f = 0; f < g.faces.rows(); ++f) order.push_back({(centroid(g.faces.row(f)) - target).squaredNorm(), f});
     std::partial_sort(order.begin(), order.begin() + std::min<std::size_t>(order.size(), 16), order.end());
     bool glued = false;
     for (std::size_t o = 0; o < std::min<std::size_t>(order.size(), 16) && !glued; ++o) {
