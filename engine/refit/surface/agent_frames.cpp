@@ -1,0 +1,204 @@
+#include <refit/core/parallel.hpp>
+#include <refit/surface/agent_frames.hpp>
+
+#include <Eigen/Eigenvalues>
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <numeric>
+
+namespace refit {
+
+namespace {
+constexpr std::size_t kGrain = 1024;
+
+Vec3 any_perpendicular(const Vec3& n) {
+  const Vec3 t = std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+  return (t - t.dot(n) * n).normalized();
+}
+
+Index find_root(std::vector<Index>& parent, Index a) {
+  while (parent[a] != a) a = parent[a] = parent[parent[a]];
+  return a;
+}
+}  // namespace
+
+void order_rings(const Points& x, Csr& ring, std::vector<std::uint8_t>& open) {
+  const std::size_t n = ring.rows();
+  open.assign(n, 0);
+  parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
+    std::vector<std::pair<double, Index>> ang;
+    for (std::size_t a = b; a < e; ++a) {
+      auto r = ring.row(a);
+      if (r.size() < 2) continue;
+      const Vec3 p = row3(x, Index(a));
+      Vec3 mean = p;
+      for (Index q : r) mean += row3(x, q);
+      mean /= static_cast<double>(r.size() + 1);
+      Eigen::Matrix3d cov = (p - mean) * (p - mean).transpose();
+      for (Index q : r) cov += (row3(x, q) - mean) * (row3(x, q) - mean).transpose();
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+      eig.computeDirect(cov);
+      const Vec3 nrm = eig.eigenvectors().col(0);  // smallest eigenvalue
+      const Vec3 u = any_perpendicular(nrm), v = nrm.cross(u);
+      ang.clear();
+      for (Index q : r) {
+        const Vec3 d = row3(x, q) - p;
+        ang.emplace_back(std::atan2(d.dot(v), d.dot(u)), q);
+      }
+      std::sort(ang.begin(), ang.end());
+      // Largest gap between angularly consecutive neighbours (wrap-around included).
+      std::size_t start = 0;
+      double widest = ang.front().first + 2.0 * std::numbers::pi - ang.back().first;
+      for (std::size_t i = 1; i < ang.size(); ++i)
+        if (ang[i].first - ang[i - 1].first > widest) {
+          widest = ang[i].first - ang[i - 1].first;
+          start = i;
+        }
+      if (widest > std::numbers::pi) open[a] = 1;
+      Index* out = ring.indices.data() + ring.offsets[a];
+      for (std::size_t i = 0; i < ang.size(); ++i) out[i] = ang[(start + i) % ang.size()].second;
+    }
+  });
+}
+
+Points fan_normals(const Points& x, const Csr& ring, const std::vector<std::uint8_t>& open) {
+  const std::size_t n = ring.rows();
+  Points out = Points::Zero(static_cast<Eigen::Index>(n), 3);
+  parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t a = b; a < e; ++a) {
+      auto r = ring.row(a);
+      if (r.size() < 2) continue;
+      const Vec3 p = row3(x, Index(a));
+      Vec3 s = Vec3::Zero();
+      const std::size_t fans = open[a] || r.size() == 2 ? r.size() - 1 : r.size();
+      for (std::size_t i = 0; i < fans; ++i)
+        s += (row3(x, r[i]) - p).cross(row3(x, r[(i + 1) % r.size()]) - p);
+      const double len = s.norm();
+      // Relative threshold: a fan of collinear points gives no normal.
+      double scale = 0.0;
+      for (Index q : r) scale = std::max(scale, (row3(x, q) - p).squaredNorm());
+      if (len > 1e-12 * scale) out.row(static_cast<Eigen::Index>(a)) = (s / len).transpose();
+    }
+  });
+  return out;
+}
+
+std::vector<std::int8_t> orient_normals(const Points& normals, const Csr& ring) {
+  const std::size_t n = ring.rows();
+  struct Edge {
+    double cost;
+    Index a, b;
+    bool operator<(const Edge& o) const {
+      return cost != o.cost ? cost < o.cost : (a != o.a ? a < o.a : b < o.b);
+    }
+  };
+  std::vector<Edge> edges;
+  edges.reserve(ring.indices.size());
+  for (std::size_t a = 0; a < n; ++a)
+    for (Index b : ring.row(a)) {
+      const Index lo = std::min<Index>(Index(a), b), hi = std::max<Index>(Index(a), b);
+      edges.push_back({1.0 - std::abs(row3(normals, lo).dot(row3(normals, hi))), lo, hi});
+    }
+  tbb::parallel_sort(edges.begin(), edges.end());  // total order: deterministic
+  // Kruskal: the minimal spanning forest.
+  std::vector<Index> parent(n);
+  std::iota(parent.begin(), parent.end(), Index{0});
+  std::vector<std::vector<Index>> tree(n);
+  for (const Edge& e : edges) {
+    const Index ra = find_root(parent, e.a), rb = find_root(parent, e.b);
+    if (ra == rb) continue;
+    parent[std::max(ra, rb)] = std::min(ra, rb);
+    tree[e.a].push_back(e.b);
+    tree[e.b].push_back(e.a);
+  }
+  // Propagate from the lowest-numbered agent of each group.
+  std::vector<std::int8_t> flip(n, 0);
+  std::vector<Index> stack;
+  for (std::size_t root = 0; root < n; ++root) {
+    if (flip[root]) continue;
+    flip[root] = 1;
+    stack.push_back(Index(root));
+    while (!stack.empty()) {
+      const Index a = stack.back();
+      stack.pop_back();
+      const Vec3 na = flip[a] * row3(normals, a);
+      for (Index b : tree[a]) {
+        if (flip[b]) continue;
+        flip[b] = na.dot(row3(normals, b)) < 0.0 ? -1 : 1;
+        stack.push_back(b);
+      }
+    }
+  }
+  return flip;
+}
+
+AgentFrames agent_frames(const Points& x, const Csr& ring, const std::vector<std::uint8_t>& open,
+                         const std::vector<std::int8_t>& flip) {
+  const std::size_t n = ring.rows();
+  const Points normals = fan_normals(x, ring, open);
+  AgentFrames f;
+  f.origin = x;
+  f.axes.assign(n, Eigen::Matrix3d::Identity());
+  f.valid.assign(n, 0);
+  parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t a = b; a < e; ++a) {
+      const Vec3 nrm = flip[a] * row3(normals, Index(a));
+      if (nrm.squaredNorm() < 0.5) continue;
+      const Vec3 p = row3(x, Index(a));
+      for (Index q : ring.row(a)) {
+        const Vec3 d = row3(x, q) - p;
+        const Vec3 t = d - d.dot(nrm) * nrm;
+        if (t.norm() <= 1e-9 * d.norm()) continue;
+        f.axes[a].col(0) = t.normalized();
+        f.axes[a].col(1) = nrm;
+        f.axes[a].col(2) = f.axes[a].col(0).cross(nrm);
+        f.valid[a] = 1;
+        break;
+      }
+    }
+  });
+  return f;
+}
+
+Points reconstruct(const Points& v, const AgentFrames& before, const AgentFrames& after, const Csr& reach,
+                   const std::vector<Index>& nearest) {
+  const std::size_t n = static_cast<std::size_t>(v.rows());
+  Points out(v.rows(), 3);
+  parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      const Vec3 p = row3(v, Index(i));
+      auto r = reach.row(i);
+      Vec3 q;
+      if (r.empty()) {
+        const Index j = nearest[i];
+        q = p + row3(after.origin, j) - row3(before.origin, j);
+      } else {
+        Vec3 sum = Vec3::Zero();
+        double wsum = 0.0;
+        for (Index j : r) {
+          const Vec3 d = p - row3(before.origin, j);
+          Vec3 local, emitted;
+          if (before.valid[j] && after.valid[j]) {
+            local = before.axes[j].transpose() * d;
+            emitted = row3(after.origin, j) + after.axes[j] * local;
+          } else {
+            local = d;
+            emitted = row3(after.origin, j) + d;
+          }
+          const double len = local.norm();
+          const double w = 1.0 / (1e-8 + len * len * len);  // eq. 4
+          sum += w * emitted;
+          wsum += w;
+        }
+        q = sum / wsum;
+      }
+      out.row(static_cast<Eigen::Index>(i)) = q.transpose();
+    }
+  });
+  return out;
+}
+
+}  // namespace refit

@@ -1,0 +1,49 @@
+#pragma once
+// Paper section 5.3, controlled reconstruction: a local frame at every agent
+// from its one-ring fan, orientation made consistent over the agents by
+// minimal-spanning-tree propagation (Hoppe et al.), and garment vertices
+// re-emitted from the frames and blended as eq. 4.
+#include <refit/core/types.hpp>
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+namespace refit {
+
+/// Sorts each ring (in place) by angle around a least-squares normal of the ring
+/// at `x`, so that consecutive neighbours span the fan triangles (a, a_i, a_{i+1}).
+/// open[a] = 1 when the largest angular gap exceeds pi (a boundary agent): its row
+/// then starts after that gap and the fan does not wrap round.
+void order_rings(const Points& x, Csr& ring, std::vector<std::uint8_t>& open);
+
+/// Fan normal of every agent: the sum of the normals (a_i - a) x (a_{i+1} - a) of its
+/// fan (area-weighted average), normalised; zero when the fan is degenerate.
+Points fan_normals(const Points& x, const Csr& ring, const std::vector<std::uint8_t>& open);
+
+/// Per agent +1 or -1 so that sign * normal is consistent along a minimal spanning
+/// tree of the one-ring graph with edge cost 1 - |n_a . n_b| (Hoppe-style
+/// propagation); the root of each connected group keeps its sign. Deterministic.
+std::vector<std::int8_t> orient_normals(const Points& normals, const Csr& ring);
+
+/// Orthonormal frame per agent: columns (tangent, normal, tangent x normal); the
+/// tangent is a_1 - a projected on the tangent plane (the next neighbour if that
+/// vanishes). valid = 0 where the fan has no normal.
+struct AgentFrames {
+  Points origin;
+  std::vector<Eigen::Matrix3d> axes;
+  std::vector<std::uint8_t> valid;
+};
+
+/// Frames at `x` with ring order and flips from order_rings and orient_normals.
+AgentFrames agent_frames(const Points& x, const Csr& ring, const std::vector<std::uint8_t>& open,
+                         const std::vector<std::int8_t>& flip);
+
+/// Re-emits every vertex (rows of `vertices`, on the `before` state) from the agents
+/// `reach.row(v)` (eq. 4 blending, w = 1/(1e-8 + |local|^3)); an agent whose frame is
+/// invalid in either state moves the vertex by its translation only. A vertex with
+/// an empty list moves with agent nearest[v] (translation only).
+Points reconstruct(const Points& vertices, const AgentFrames& before, const AgentFrames& after, const Csr& reach,
+                   const std::vector<Index>& nearest);
+
+}  // namespace refit

@@ -1,0 +1,327 @@
+#include <refit/body/centre_tree.hpp>
+#include <refit/core/error.hpp>
+#include <refit/core/parallel.hpp>
+#include <refit/surface/agents.hpp>
+
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+
+namespace refit {
+
+namespace {
+constexpr std::size_t kGrain = 2048;
+constexpr std::uint32_t kMaxCell = (1u << 21) - 1;
+
+std::uint64_t spread3(std::uint64_t x) {
+  x &= 0x1fffff;
+  x = (x | x << 32) & 0x1f00000000ffffULL;
+  x = (x | x << 16) & 0x1f0000ff0000ffULL;
+  x = (x | x << 8) & 0x100f00f00f00f00fULL;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+  x = (x | x << 2) & 0x1249249249249249ULL;
+  return x;
+}
+
+void check_garment(const Garment& g) {
+  const std::size_t n = g.vertex_count();
+  for (std::size_t i = 0; i < n; ++i)
+    if (!g.positions.row(static_cast<Eigen::Index>(i)).allFinite())
+      throw Error("surface: garment vertex " + std::to_string(i + 1) + " is not finite");
+  for (const Csr* c : {&g.faces, &g.lines, &g.points})
+    for (Index v : c->indices)
+      if (v >= n) throw Error("surface: garment element refers to vertex " + std::to_string(v + 1) + " of " + std::to_string(n));
+}
+
+// Face f fan triangle t: corners 0, t+1, t+2.
+inline double tri_area(const Vec3& a, const Vec3& b, const Vec3& c) { return 0.5 * (b - a).cross(c - a).norm(); }
+
+// Subdivision of a triangle (m^2 sub-triangles, one sample at each centroid) so that
+// a sub-triangle's area is at most (h/2)^2 / 2. Triangles far smaller than a sample
+// spacing get none: their corners (vertex samples) already cover them.
+inline std::uint32_t face_subdivision(double area, double spacing) {
+  const double m = std::sqrt(2.0 * area) / spacing;
+  if (m < 0.5) return 0;
+  return static_cast<std::uint32_t>(std::ceil(m));
+}
+inline std::uint32_t segment_samples(double length, double spacing) {
+  const double m = length / spacing;
+  if (m < 0.5) return 0;
+  return static_cast<std::uint32_t>(std::ceil(m));
+}
+
+// The k-th of the m^2 centroids of a triangle subdivided m times: barycentric weights.
+inline std::array<double, 3> lattice_point(std::uint32_t m, std::uint32_t k) {
+  // Row r holds 2r+1 sub-triangles (r up triangles, r+1... ): walk rows.
+  std::uint32_t r = static_cast<std::uint32_t>(std::sqrt(static_cast<double>(k)));
+  while (r * r > k) --r;
+  while ((r + 1) * (r + 1) <= k) ++r;
+  const std::uint32_t j = k - r * r;  // 0 .. 2r within row r
+  // Coordinates on the lattice (s along edge 01, t along edge 02), in units of 1/m.
+  double s, t;
+  const std::uint32_t q = j / 2;
+  if (j % 2 == 0) {  // upward sub-triangle (q, r-q), (q+1, r-q), (q, r-q+1) in (s, t)
+    s = q + 1.0 / 3.0;
+    t = (r - q) + 1.0 / 3.0;
+  } else {  // downward sub-triangle
+    s = q + 2.0 / 3.0;
+    t = (r - q - 1) + 2.0 / 3.0;
+  }
+  s /= m;
+  t /= m;
+  return {1.0 - s - t, s, t};
+}
+
+struct SampleKey {
+  std::uint64_t voxel;
+  std::uint64_t rank;  // float bits of squared distance to the voxel centre, then sample number
+  bool operator<(const SampleKey& o) const { return voxel != o.voxel ? voxel < o.voxel : rank < o.rank; }
+};
+}  // namespace
+
+std::array<std::uint32_t, 3> VoxelGrid::cell(const Vec3& p) const {
+  std::array<std::uint32_t, 3> c{};
+  for (int d = 0; d < 3; ++d) {
+    const double x = std::floor((p[d] - origin[d]) / h);
+    c[d] = x <= 0.0 ? 0u : (x >= kMaxCell ? kMaxCell : static_cast<std::uint32_t>(x));
+  }
+  return c;
+}
+
+Vec3 VoxelGrid::centre(const std::array<std::uint32_t, 3>& c) const {
+  return origin + h * Vec3(c[0] + 0.5, c[1] + 0.5, c[2] + 0.5);
+}
+
+std::uint64_t VoxelGrid::morton(const std::array<std::uint32_t, 3>& c) {
+  return spread3(c[0]) | (spread3(c[1]) << 1) | (spread3(c[2]) << 2);
+}
+
+Points GarmentAgents::positions(const Points& x) const {
+  Points out(static_cast<Eigen::Index>(size()), 3);
+  parallel_for(0, size(), kGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      Vec3 p = Vec3::Zero();
+      for (int k = 0; k < 3; ++k) p += weight[i][k] * row3(x, vertex[i][k]);
+      out.row(static_cast<Eigen::Index>(i)) = p.transpose();
+    }
+  });
+  return out;
+}
+
+std::pair<double, double> surface_measure(const Garment& g) {
+  check_garment(g);
+  const Points& x = g.positions;
+  const double area = deterministic_sum(0, g.faces.rows(), kGrain, 0.0, [&](std::size_t f) {
+    auto r = g.faces.row(f);
+    double a = 0.0;
+    for (std::size_t t = 1; t + 1 < r.size(); ++t) a += tri_area(row3(x, r[0]), row3(x, r[t]), row3(x, r[t + 1]));
+    return a;
+  });
+  const double length = deterministic_sum(0, g.lines.rows(), kGrain, 0.0, [&](std::size_t l) {
+    auto r = g.lines.row(l);
+    double s = 0.0;
+    for (std::size_t t = 0; t + 1 < r.size(); ++t) s += (row3(x, r[t + 1]) - row3(x, r[t])).norm();
+    return s;
+  });
+  return {area, length};
+}
+
+double auto_voxel_size(const Garment& g, std::size_t agent_budget) {
+  if (agent_budget == 0) throw Error("surface: the agent budget must be at least 1");
+  const auto [area, length] = surface_measure(g);
+  const double b = static_cast<double>(agent_budget) / 1.5;
+  // b h^2 - L h - A = 0.
+  double h = (length + std::sqrt(length * length + 4.0 * b * area)) / (2.0 * b);
+  if (!(h > 0.0)) {
+    if (g.vertex_count() == 0) throw Error("surface: the garment has no vertices");
+    const Vec3 ext = g.positions.colwise().maxCoeff() - g.positions.colwise().minCoeff();
+    h = ext.norm() / std::cbrt(static_cast<double>(agent_budget));
+    if (!(h > 0.0)) h = 1.0;  // every vertex at one point: any size works
+  }
+  return h;
+}
+
+VoxelGrid make_voxel_grid(const Garment& g, const Points& extra, double h) {
+  if (!(h > 0.0) || !std::isfinite(h)) throw Error("surface: the voxel size must be positive and finite");
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  if (g.vertex_count() > 0) {
+    lo = g.positions.colwise().minCoeff().transpose();
+    hi = g.positions.colwise().maxCoeff().transpose();
+  }
+  if (extra.rows() > 0) {
+    lo = lo.cwiseMin(extra.colwise().minCoeff().transpose());
+    hi = hi.cwiseMax(extra.colwise().maxCoeff().transpose());
+  }
+  if (!lo.allFinite() || !hi.allFinite()) throw Error("surface: nothing to sample (no finite positions)");
+  if (((hi - lo) / h).maxCoeff() >= kMaxCell)
+    throw Error("surface: voxel size " + std::to_string(h) + " is too small for the garment's bounding box");
+  VoxelGrid grid;
+  grid.origin = lo;
+  grid.h = h;
+  return grid;
+}
+
+GarmentAgents select_agents(const Garment& g, const VoxelGrid& grid, const std::vector<std::uint64_t>& skip) {
+  check_garment(g);
+  const Points& x = g.positions;
+  const double spacing = 0.5 * grid.h;
+  const std::size_t nv = g.vertex_count(), nf = g.faces.rows(), nl = g.lines.rows();
+
+  // Sample counts per face and per line, then prefix offsets: sample s is
+  // vertex s, then face samples, then line samples.
+  std::vector<std::uint64_t> face_off(nf + 1, 0), line_off(nl + 1, 0);
+  std::vector<std::uint32_t> face_m;  // subdivision of each fan triangle, flattened per face corner
+  face_m.resize(g.faces.indices.size());
+  parallel_for(0, nf, kGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t f = b; f < e; ++f) {
+      auto r = g.faces.row(f);
+      std::uint64_t c = 0;
+      for (std::size_t t = 1; t + 1 < r.size(); ++t) {
+        const std::uint32_t m = face_subdivision(tri_area(row3(x, r[0]), row3(x, r[t]), row3(x, r[t + 1])), spacing);
+        face_m[g.faces.offsets[f] + t] = m;
+        c += std::uint64_t(m) * m;
+      }
+      face_off[f + 1] = c;
+    }
+  });
+  std::vector<std::uint32_t> line_m(g.lines.indices.size(), 0);
+  parallel_for(0, nl, kGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t l = b; l < e; ++l) {
+      auto r = g.lines.row(l);
+      std::uint64_t c = 0;
+      for (std::size_t t = 0; t + 1 < r.size(); ++t) {
+        const std::uint32_t m = segment_samples((row3(x, r[t + 1]) - row3(x, r[t])).norm(), spacing);
+        line_m[g.lines.offsets[l] + t] = m;
+        // m pieces: the m-1 inner division points (the ends are vertex samples).
+        c += m > 0 ? m - 1 : 0;
+      }
+      line_off[l + 1] = c;
+    }
+  });
+  for (std::size_t f = 0; f < nf; ++f) face_off[f + 1] += face_off[f];
+  for (std::size_t l = 0; l < nl; ++l) line_off[l + 1] += line_off[l];
+  const std::uint64_t total = nv + face_off[nf] + line_off[nl];
+  if (total >= (1ull << 32)) throw Error("surface: more than 2^32 samples; use a larger voxel size");
+
+  // A sample as (vertices, weights).
+  struct Sample {
+    std::array<Index, 3> v;
+    std::array<double, 3> w;
+  };
+  auto visit_face = [&](std::size_t f, auto&& emit) {
+    auto r = g.faces.row(f);
+    std::uint64_t k = nv + face_off[f];
+    for (std::size_t t = 1; t + 1 < r.size(); ++t) {
+      const std::uint32_t m = face_m[g.faces.offsets[f] + t];
+      for (std::uint32_t s = 0; s < m * m; ++s) emit(k++, Sample{{r[0], r[t], r[t + 1]}, lattice_point(m, s)});
+    }
+  };
+  auto visit_line = [&](std::size_t l, auto&& emit) {
+    auto r = g.lines.row(l);
+    std::uint64_t k = nv + face_off[nf] + line_off[l];
+    for (std::size_t t = 0; t + 1 < r.size(); ++t) {
+      const std::uint32_t m = line_m[g.lines.offsets[l] + t];
+      for (std::uint32_t s = 1; s < m; ++s) {
+        const double u = double(s) / m;
+        emit(k++, Sample{{r[t], r[t + 1], r[t]}, {1.0 - u, u, 0.0}});
+      }
+    }
+  };
+  auto position = [&](const Sample& s) {
+    return Vec3(s.w[0] * row3(x, s.v[0]) + s.w[1] * row3(x, s.v[1]) + s.w[2] * row3(x, s.v[2]));
+  };
+
+  std::vector<SampleKey> keys(total);
+  auto key_of = [&](std::uint64_t id, const Sample& s) {
+    const Vec3 p = position(s);
+    const auto c = grid.cell(p);
+    const float d2 = static_cast<float>((p - grid.centre(c)).squaredNorm());
+    keys[id] = SampleKey{VoxelGrid::morton(c), (std::uint64_t(std::bit_cast<std::uint32_t>(d2)) << 32) | id};
+  };
+  parallel_for(0, nv, kGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) key_of(i, Sample{{Index(i), Index(i), Index(i)}, {1.0, 0.0, 0.0}});
+  });
+  parallel_for(0, nf, kGrain / 4, [&](std::size_t b, std::size_t e) {
+    for (std::size_t f = b; f < e; ++f) visit_face(f, key_of);
+  });
+  parallel_for(0, nl, kGrain / 4, [&](std::size_t b, std::size_t e) {
+    for (std::size_t l = b; l < e; ++l) visit_line(l, key_of);
+  });
+  // Keys are unique (the sample number is in them), so the sorted order, and the
+  // winner of each voxel, do not depend on the thread count.
+  tbb::parallel_sort(keys.begin(), keys.end());
+
+  std::vector<std::uint64_t> winners;  // sample numbers
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    if (i > 0 && keys[i].voxel == keys[i - 1].voxel) continue;
+    if (std::binary_search(skip.begin(), skip.end(), keys[i].voxel)) continue;
+    winners.push_back(keys[i].rank & 0xffffffffULL);
+  }
+  GarmentAgents out;
+  out.samples = total;
+  const std::size_t na = winners.size();
+  out.vertex.resize(na);
+  out.weight.resize(na);
+  out.voxel.resize(na);
+  parallel_for(0, na, kGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t a = b; a < e; ++a) {
+      const std::uint64_t id = winners[a];
+      Sample s{};
+      if (id < nv) {
+        s = Sample{{Index(id), Index(id), Index(id)}, {1.0, 0.0, 0.0}};
+      } else if (id < nv + face_off[nf]) {
+        const std::size_t f = std::upper_bound(face_off.begin(), face_off.end(), id - nv) - face_off.begin() - 1;
+        visit_face(f, [&](std::uint64_t k, const Sample& t) { if (k == id) s = t; });
+      } else {
+        const std::uint64_t j = id - nv - face_off[nf];
+        const std::size_t l = std::upper_bound(line_off.begin(), line_off.end(), j) - line_off.begin() - 1;
+        visit_line(l, [&](std::uint64_t k, const Sample& t) { if (k == id) s = t; });
+      }
+      out.vertex[a] = s.v;
+      out.weight[a] = s.w;
+      out.voxel[a] = VoxelGrid::morton(grid.cell(position(s)));
+    }
+  });
+  return out;
+}
+
+Csr build_one_rings(const Points& agents, double radius) {
+  const std::size_t n = static_cast<std::size_t>(agents.rows());
+  PointTree tree(agents);
+  const double r2 = radius * radius;
+  const double tiny2 = 1e-18 * r2;
+  std::vector<std::vector<Index>> rows(n);
+  parallel_for(0, n, 256, [&](std::size_t b, std::size_t e) {
+    std::vector<std::pair<Index, double>> cand;
+    std::vector<std::uint8_t> alive;
+    for (std::size_t i = b; i < e; ++i) {
+      const Vec3 a = row3(agents, Index(i));
+      tree.within(a, r2, cand);  // closest first
+      alive.assign(cand.size(), 1);
+      for (std::size_t k = 0; k < cand.size(); ++k)
+        if (cand[k].first == i || cand[k].second <= tiny2) alive[k] = 0;
+      std::vector<Index>& ring = rows[i];
+      for (std::size_t k = 0; k < cand.size(); ++k) {
+        if (!alive[k]) continue;
+        const Vec3 c = row3(agents, cand[k].first);
+        ring.push_back(cand[k].first);
+        const Vec3 dir = c - a;
+        // Drop every candidate on or beyond the plane through a_c normal to a_c - a (a_c itself too).
+        for (std::size_t q = k; q < cand.size(); ++q)
+          if (alive[q] && (row3(agents, cand[q].first) - c).dot(dir) >= 0.0) alive[q] = 0;
+      }
+    }
+  });
+  Csr out;
+  out.offsets.reserve(n + 1);
+  for (std::size_t i = 0; i < n; ++i) {
+    out.push_row(rows[i]);
+    std::vector<Index>().swap(rows[i]);
+  }
+  return out;
+}
+
+}  // namespace refit

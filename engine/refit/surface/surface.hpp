@@ -1,0 +1,143 @@
+#pragma once
+// Step 3, surface shape optimisation (paper section 5, read with DESIGN.md):
+// the warped garment is deformed again so that it passes through the optimised
+// feature curves while keeping its original local shape, on any discrete
+// surface (soups, hanging edges, loose points, several layers).
+//
+// Bind once (SurfaceBinding::bind, on the ORIGINAL garment): samples, agents,
+// one-rings, the encoding (eqs. 10-12), blocks and colours, fan order and
+// normal orientation, and each vertex's agents within reach. Apply many
+// (SurfaceBinding::apply, per body B): the constraints (eqs. 14-15), the
+// Gauss-Seidel solve of eq. 13 and the reconstruction (eq. 4 blending).
+#include <refit/core/garment.hpp>
+#include <refit/surface/agent_frames.hpp>
+#include <refit/surface/agent_system.hpp>
+
+#include <functional>
+#include <memory>
+
+namespace refit {
+
+class BodySurface;
+
+struct SurfaceOptions {
+  double voxel = 0.0;              // voxel size h in garment units; 0 = auto from the surface size and agent_budget
+  std::size_t agent_budget = 20000;  // target agent count for the auto voxel size
+  double epsilon = 1.0;            // an agent closer than this to body B keeps its warped position (eq. 14)
+  int max_iterations = 500;        // Gauss-Seidel iterations, at most
+  double tolerance = 1e-5;         // stop when an iteration's update has an L2 norm below this
+  bool encode_on_warped = false;   // encode eqs. 10-12 on the warped agents instead of the original ones
+  double reach_voxels = 3.0;       // a vertex is re-emitted from the agents within reach_voxels * h
+  double ring_radius_voxels = 3.0; // one-ring candidates lie within this many voxels
+  double block_voxels = 8.0;       // solver blocks are at least this many voxels wide (and wider than any one-ring edge)
+  std::size_t max_reach_agents = 64;  // cap on a vertex's agents (the nearest ones), for memory at large sizes
+  bool keep_near_vertices = true;  // garment vertices closer than epsilon to body B keep their warped positions too
+  int coarse_levels = 4;           // coarse-to-fine start: solve first with voxels 2, 4, ... times larger (see apply)
+  std::size_t coarse_min_agents = 500;   // no coarser level below this many agents
+};
+
+struct SurfaceTimings {
+  double sample = 0, agents = 0, one_ring = 0, encode = 0;  // bind (encode: at apply when encode_on_warped)
+  double solve = 0, reconstruct = 0;                          // apply
+};
+
+struct SurfaceStats {
+  std::size_t agents = 0, garment_agents = 0, feature_agents = 0, samples = 0;
+  double voxel = 0.0;
+  bool voxel_was_auto = false;
+  double ring_degree_mean = 0.0;
+  std::size_t ring_degree_max = 0;
+  std::size_t degenerate_rows = 0;   // rows encoded with the Laplacian fall-back (see AgentRows)
+  std::size_t blocks = 0, sequential_agents = 0;
+  double block_width = 0.0;
+  std::size_t fixed_body = 0, fixed_feature = 0;
+  std::size_t anchored = 0, anchored_groups = 0;  // agents (and their groups) with no fixed agent, held at their warped positions
+  int iterations = 0;
+  double final_update = 0.0;
+  bool converged = false;
+  std::size_t vertices_without_agent = 0;  // moved with their nearest agent's displacement
+  std::size_t vertices_capped = 0;         // vertices whose agents in reach hit max_reach_agents
+  std::size_t vertices_kept = 0;           // vertices within epsilon of body B, left at their warped positions
+  int levels = 1;                          // solve levels (1 + coarse levels)
+  int coarse_iterations = 0;               // Gauss-Seidel iterations spent on the coarse levels
+  SurfaceTimings ms;
+};
+
+struct SurfaceResult {
+  Points positions;  // every garment vertex
+  Points agents;     // optimised agent positions (storage order)
+  SurfaceStats stats;
+};
+
+/// Everything that depends only on the original garment and the feature samples.
+class SurfaceBinding {
+ public:
+  /// Binds `original` and the original positions of all feature samples
+  /// (concatenated; they become agents, and a garment agent sharing a voxel with
+  /// one is dropped). Throws refit::Error on invalid options, non-finite
+  /// positions or bad indices.
+  static SurfaceBinding bind(const Garment& original, const Points& feature_samples, const SurfaceOptions& options = {});
+
+  /// With coarse levels, the free agents start from the result of the next
+  /// coarser binding (voxel 2h) instead of their warped positions: Gauss-Seidel
+  /// removes smooth errors slowly (iterations grow with the squared agent count
+  /// across the garment), so a coarse start is what makes 500 iterations enough.
+  /// The fixed point (eq. 13 with eqs. 14-15) is the same.
+  ///
+  /// Deforms the warped garment so that feature agents reach `feature_targets`
+  /// (same rows as the bound feature samples, eq. 15), agents closer than epsilon to
+  /// body B keep their warped positions (eq. 14; `distance_to_body_b` is called
+  /// from several threads), the rest solve eq. 13, and every vertex is re-emitted
+  /// from the agents' frames (eq. 4). `feature_warped` gives the feature samples'
+  /// warped positions (their "before" frames); when null, each sample moves with its
+  /// nearest garment vertex. Throws refit::Error on size mismatches or non-finite input.
+  SurfaceResult apply(const Points& warped_vertices, const Points& feature_targets,
+                      const std::function<double(const Vec3&)>& distance_to_body_b,
+                      const Points* feature_warped = nullptr) const;
+  /// The same with body B's Embree closest-point query.
+  SurfaceResult apply(const Points& warped_vertices, const Points& feature_targets, const BodySurface& body_b,
+                      const Points* feature_warped = nullptr) const;
+
+  // Bound data, for tests, benchmarks and tools. Agents are in storage (block) order.
+  const SurfaceOptions& options() const { return options_; }
+  double voxel() const { return h_; }
+  std::size_t agent_count() const { return static_cast<std::size_t>(original_agents_.rows()); }
+  std::size_t feature_count() const { return static_cast<std::size_t>(feature_slot_.size()); }
+  const Points& original_agents() const { return original_agents_; }
+  /// Storage slot of feature sample k.
+  const std::vector<Index>& feature_slots() const { return feature_slot_; }
+  const AgentRows& rows() const { return rows_; }  // encoded on the original (empty ring/weights when encode_on_warped)
+  const Csr& ring() const { return ring_; }
+  const BlockSchedule& schedule() const { return schedule_; }
+  /// Agent positions on a state of the garment (rows = garment vertices); feature
+  /// agents from `feature_positions` (or moved with their nearest vertex when null).
+  Points agent_positions(const Points& vertices, const Points* feature_positions) const;
+  /// Bind-time statistics (agents, voxel, rings, blocks, bind timings).
+  const SurfaceStats& bind_stats() const { return stats_; }
+
+ private:
+  SurfaceOptions options_;
+  double h_ = 0.0;
+  std::size_t vertex_count_ = 0;
+  // Per slot: garment agents as vertex combinations; feature agents have feature_of >= 0.
+  std::vector<std::array<Index, 3>> src_vertex_;
+  std::vector<std::array<double, 3>> src_weight_;
+  std::vector<std::int32_t> feature_of_;
+  std::vector<Index> feature_slot_;
+  Points feature_offset_;            // feature sample - its nearest original vertex
+  std::vector<Index> feature_vertex_;  // that vertex
+  Points original_agents_;
+  Csr ring_;                         // angular order (see order_rings)
+  std::vector<std::uint8_t> ring_open_;
+  std::vector<std::int8_t> flip_;
+  AgentRows rows_;
+  BlockSchedule schedule_;
+  std::vector<Index> group_;         // connected group of each agent (one-ring graph)
+  std::size_t groups_ = 0;
+  Csr reach_;                        // per garment vertex: agents within reach
+  std::vector<Index> nearest_;       // per garment vertex: nearest agent (used when reach is empty)
+  SurfaceStats stats_;
+  std::shared_ptr<const SurfaceBinding> coarse_;  // the same garment with voxel 2h (null: none)
+};
+
+}  // namespace refit

@@ -1,0 +1,204 @@
+// End to end on the procedural dress: warp (step 1), feature curves (step 2),
+// then the surface (step 3) to a body with a belly bump.
+#include <refit/body/body_surface.hpp>
+#include <refit/features/curve_metrics.hpp>
+#include <refit/features/feature_curves.hpp>
+#include <refit/features/feature_file.hpp>
+#include <refit/features/shape_matching.hpp>
+
+#include <Eigen/Geometry>
+#include <refit/surface/surface.hpp>
+#include <refit/warp/warp.hpp>
+
+#include <mannequin/mannequin.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <numbers>
+
+namespace refit {
+namespace {
+
+namespace mq = refit::mannequin;
+
+struct Case {
+  Garment dress;
+  Points warped, result;
+  SurfaceStats stats;
+  std::vector<CurveResult> curves;
+  double skirt_top = 0, skirt_bottom = 0;
+  std::vector<double> body_distance;  // of each warped vertex to body B
+};
+
+Case run_dress(bool soup, std::size_t target_vertices = 6000, SurfaceOptions so = {}) {
+  const mq::BodyParams a{};
+  mq::BodyParams b = a;
+  b.belly = 8;
+  b.hip = a.hip + 6;
+  mq::GarmentParams gp;
+  gp.kind = mq::GarmentParams::Kind::Dress;
+  gp.target_vertices = target_vertices;
+  gp.soup = soup;
+  gp.ease = -0.5;  // bodice 1 cm over the body: on the edge of epsilon
+  Case c;
+  c.dress = mq::make_garment(a, gp);
+  const ReferenceBody ref(mq::make_body(a));
+  const BodyMesh body_b = mq::make_body(b);
+  const TriangleFrames frames_b = compute_frames(body_b);
+  const BodySurface surface_b(body_b);
+  c.warped = ref.bind(c.dress.positions).apply(frames_b);
+
+  const auto specs = parse_feature_json(mq::dress_features_json(a, gp), "dress_features.json", "cm");
+  // Feature samples from the features module (slices of the original dress);
+  // warped with step 1; targets made here, independent of step 2: the original
+  // profile moved onto the warped one by the best similarity (Umeyama), that is
+  // a profile with exactly its original shape where the warp put it.
+  const auto curves = build_feature_curves(c.dress, specs);
+  const WarpBinding fw_bind = [&] {
+    std::size_t m = 0;
+    for (const auto& fc : curves) m += fc.samples.rows();
+    Points all(Eigen::Index(m), 3);
+    Eigen::Index r = 0;
+    for (const auto& fc : curves) {
+      all.middleRows(r, fc.samples.rows()) = fc.samples;
+      r += fc.samples.rows();
+    }
+    return ref.bind(all);
+  }();
+  const Points all_warped = fw_bind.apply(frames_b);
+  std::size_t m = 0;
+  for (const auto& fc : curves) m += fc.samples.rows();
+  Points samples(Eigen::Index(m), 3), targets(Eigen::Index(m), 3), fwarped = all_warped;
+  Eigen::Index row = 0;
+  for (const auto& fc : curves) {
+    const Eigen::Index k = fc.samples.rows();
+    samples.middleRows(row, k) = fc.samples;
+    const Eigen::Matrix3Xd src = fc.samples.transpose(), dst = all_warped.middleRows(row, k).transpose();
+    const Eigen::Matrix4d t = Eigen::umeyama(src, dst, true);
+    targets.middleRows(row, k) = ((t.topLeftCorner<3, 3>() * src).colwise() + t.topRightCorner<3, 1>()).transpose();
+    CurveResult cr;
+    cr.name = fc.name;
+    cr.original = fc.samples;
+    cr.warped = all_warped.middleRows(row, k);
+    cr.optimised = targets.middleRows(row, k);
+    c.curves.push_back(cr);
+    row += k;
+  }
+  const SurfaceBinding sb = SurfaceBinding::bind(c.dress, samples, so);
+  const SurfaceResult r = sb.apply(c.warped, targets, surface_b, &fwarped);
+  c.result = r.positions;
+  c.stats = r.stats;
+  const mq::Landmarks lv = mq::landmarks(a);
+  c.skirt_top = lv.waist;
+  c.skirt_bottom = lv.knee;
+  c.body_distance.resize(c.warped.rows());
+  for (Eigen::Index v = 0; v < c.warped.rows(); ++v) c.body_distance[v] = surface_b.closest(row3(c.warped, Index(v))).distance;
+  return c;
+}
+
+// Garment vertices within `band` of a vertical half plane through the body axis at
+// angle phi (0 = +x, pi/2 = front), on the skirt, ordered by height: a "curve" whose
+// shape in the original, the warp and the result can be compared.
+std::vector<Index> half_plane_vertices(const Case& c, double phi, double band) {
+  const Vec3 dir(std::cos(phi), 0, std::sin(phi)), normal(-std::sin(phi), 0, std::cos(phi));
+  std::vector<std::pair<double, Index>> found;
+  for (Eigen::Index v = 0; v < c.dress.positions.rows(); ++v) {
+    const Vec3 p = row3(c.dress.positions, Index(v));
+    if (p.y() > c.skirt_top - 3 || p.y() < c.skirt_bottom + 3) continue;
+    if (std::abs(p.dot(normal)) < band && p.dot(dir) > 0) found.emplace_back(p.y(), Index(v));
+  }
+  std::sort(found.begin(), found.end());
+  std::vector<Index> out;
+  for (const auto& f : found) out.push_back(f.second);
+  return out;
+}
+Points rows_of(const Points& p, const std::vector<Index>& idx) {
+  Points out(Eigen::Index(idx.size()), 3);
+  for (std::size_t i = 0; i < idx.size(); ++i) out.row(Eigen::Index(i)) = p.row(idx[i]);
+  return out;
+}
+
+TEST(SurfaceDress, FollowsTheProfilesAndKeepsTheBodyContact) {
+  const Case c = run_dress(false);
+  ASSERT_TRUE(c.result.allFinite());
+  EXPECT_GT(c.stats.fixed_feature, 0u);
+  EXPECT_GT(c.stats.fixed_body, 0u);
+  std::printf("dress: %zu vertices, %zu agents (voxel %.3f cm), degree %.2f/%zu, fixed body %zu feature %zu, "
+              "anchored %zu in %zu groups, %d levels, %d iterations (+%d coarse), update %.2e, ms: sample %.1f agents %.1f one_ring %.1f "
+              "encode %.1f solve %.1f reconstruct %.1f\n",
+              c.dress.vertex_count(), c.stats.agents, c.stats.voxel, c.stats.ring_degree_mean, c.stats.ring_degree_max,
+              c.stats.fixed_body, c.stats.fixed_feature, c.stats.anchored, c.stats.anchored_groups, c.stats.levels,
+              c.stats.iterations, c.stats.coarse_iterations,
+              c.stats.final_update, c.stats.ms.sample, c.stats.ms.agents, c.stats.ms.one_ring, c.stats.ms.encode,
+              c.stats.ms.solve, c.stats.ms.reconstruct);
+
+  // Vertices within 1 cm of body B stay (nearly) where the warp put them.
+  double worst_near = 0.0;
+  std::size_t near = 0;
+  for (Eigen::Index v = 0; v < c.warped.rows(); ++v)
+    if (c.body_distance[v] < 1.0) {
+      ++near;
+      worst_near = std::max(worst_near, (c.result.row(v) - c.warped.row(v)).norm());
+    }
+  std::printf("  %zu vertices within 1 cm of body B: largest move %.4f cm\n", near, worst_near);
+  EXPECT_GT(near, 100u);
+  EXPECT_LT(worst_near, 1e-12);
+
+  // The side profiles (features at phi = 0 and pi) and a held-out slice between
+  // the side and the front profiles (phi = pi/4, not a feature).
+  for (const double phi : {0.0, std::numbers::pi, std::numbers::pi / 4, 3 * std::numbers::pi / 4}) {
+    const auto idx = half_plane_vertices(c, phi, 0.4);
+    ASSERT_GE(idx.size(), 10u) << phi;
+    const Points orig = rows_of(c.dress.positions, idx);
+    const double e_warp = shape_error(rows_of(c.warped, idx), orig, false);
+    const double e_res = shape_error(rows_of(c.result, idx), orig, false);
+    std::printf("  slice at %.0f deg (%zu vertices): shape error warp %.5f result %.5f (gain %.1f)\n",
+                phi * 180 / std::numbers::pi, idx.size(), e_warp, e_res, e_warp / e_res);
+    const bool feature = std::abs(std::sin(phi)) < 1e-9;
+    // The targets are 10x on the profiles and 3x between them; measured on
+    // vertices within 0.4 cm of the plane we reach about 6x and 2.1-3.8x (see the
+    // module's report), so this guards what is reached.
+    EXPECT_LT(e_res * (feature ? 5.0 : 2.0), e_warp) << "slice at " << phi;
+  }
+  // The feature curves themselves (step 2's own numbers, for the record).
+  for (const auto& cr : c.curves)
+    std::printf("  curve %s: shape error warp %.5f target %.5f\n", cr.name.c_str(),
+                shape_error(cr.warped, cr.original, false), shape_error(cr.optimised, cr.original, false));
+}
+
+TEST(SurfaceDress, ManifoldAndSoupAgree) {
+  SurfaceOptions so;
+  so.voxel = 1.6;  // the same grid for both (the auto size follows the vertex count)
+  const Case m = run_dress(false, 6000, so);
+  const Case s = run_dress(true, 6000, so);
+  ASSERT_TRUE(s.result.allFinite());
+  // Soup vertices that coincide with a manifold vertex in the original.
+  std::map<std::array<double, 3>, Index> where;
+  for (Eigen::Index v = 0; v < m.dress.positions.rows(); ++v)
+    where[{m.dress.positions(v, 0), m.dress.positions(v, 1), m.dress.positions(v, 2)}] = Index(v);
+  std::size_t matched = 0;
+  double worst = 0.0, sum = 0.0, moved = 0.0;
+  for (Eigen::Index v = 0; v < s.dress.positions.rows(); ++v) {
+    auto it = where.find({s.dress.positions(v, 0), s.dress.positions(v, 1), s.dress.positions(v, 2)});
+    if (it == where.end()) continue;
+    ++matched;
+    const double d = (s.result.row(v) - m.result.row(it->second)).norm();
+    worst = std::max(worst, d);
+    sum += d;
+    moved += (m.result.row(it->second) - m.warped.row(it->second)).norm();
+  }
+  std::printf("soup vs manifold: %zu matched vertices, mean difference %.4f cm, max %.4f cm; mean step-3 move %.4f cm\n",
+              matched, sum / double(matched), worst, moved / double(matched));
+  EXPECT_GT(matched, m.dress.vertex_count() * 9 / 10);
+  // Measured: mean 0.16 cm, max 1.5 cm for a mean step-3 correction of the
+  // order of a centimetre; the agents differ near the soup's extras (flap,
+  // drawstrings, buttons) and where the duplicated seams change the samples.
+  EXPECT_LT(sum, 0.4 * moved);
+  EXPECT_LT(worst, 2.0);
+}
+
+}  // namespace
+}  // namespace refit
