@@ -176,3 +176,53 @@ TEST(Cli, DemoWritesItsFiles) {
 
 }  // namespace
 }  // namespace refit
+
+namespace refit {
+namespace {
+
+// Every line that is not `v` or `vn` must come back byte for byte.
+std::vector<std::string> non_position_lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    const std::string line = text.substr(start, end - start);
+    if (line.rfind("v ", 0) != 0 && line.rfind("vn ", 0) != 0) lines.push_back(line);
+    start = end + 1;
+  }
+  return lines;
+}
+
+TEST(CliRoundTrip, SoupKeepsEverythingButPositions) {
+  const std::string data = test::shared_data_dir();
+  if (data.empty()) GTEST_SKIP() << "../shared/data is absent: real soup round trip skipped";
+  test::TempDir dir;
+  const std::string in = data + "/garments/dress_soup_on_A_female.obj", out = dir.file("out.obj");
+  const auto r = run_cli("resize --quiet --garment '" + in + "' --from '" + data + "/bodies/A_female.obj' --to '" + data +
+                         "/bodies/F_heavier.obj' --out '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string a = test::read_text(in), b = test::read_text(out);
+  EXPECT_EQ(non_position_lines(a), non_position_lines(b));
+  EXPECT_NE(a, b);
+  const Garment g = read_garment_obj(out);
+  EXPECT_EQ(g.vertex_count(), 3656u);
+  EXPECT_EQ(g.lines.rows(), 3u);
+  EXPECT_EQ(g.points.rows(), 2u);
+  EXPECT_TRUE(g.positions.allFinite());
+}
+
+TEST(CliRoundTrip, ProceduralSoupKeepsLinesPointsAndLooseVertices) {
+  const Case c;
+  mannequin::GarmentParams g;
+  g.target_vertices = 5000;
+  g.soup = true;
+  const std::string soup = c.dir.file("soup.obj"), out = c.dir.file("out.obj");
+  write_garment_obj(soup, mannequin::make_garment({}, g));
+  const auto r = run_cli("resize --quiet --garment '" + soup + "' --from '" + c.a + "' --to '" + c.b + "' --out '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(non_position_lines(test::read_text(soup)), non_position_lines(test::read_text(out)));
+}
+
+}  // namespace
+}  // namespace refit
