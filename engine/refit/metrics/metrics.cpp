@@ -216,9 +216,13 @@ ResizeMetrics compute_metrics(const Garment& original, const Points& result, con
   return compute_metrics(original, result, sa, sb, options);
 }
 
-Points carry_points(const Garment& original, const Points& result, const Points& samples) {
+SurfaceAttachment attach_points(const Garment& original, const Points& samples) {
   const Index nv = static_cast<Index>(original.positions.rows());
-  Points out(samples.rows(), 3);
+  const auto n = static_cast<std::size_t>(samples.rows());
+  SurfaceAttachment at;
+  at.vertex.resize(n);
+  at.weight.resize(n);
+  at.offset.resize(samples.rows(), 3);
   BodyMesh shell;  // the garment's faces as a triangle soup for Embree's closest-point query
   shell.vertices = original.positions;
   shell.name = "garment";
@@ -227,35 +231,54 @@ Points carry_points(const Garment& original, const Points& result, const Points&
     for (std::size_t k = 1; k + 1 < face.size(); ++k) shell.triangles.push_back({face[0], face[k], face[k + 1]});
   }
   if (shell.triangles.empty()) {
-    for (Eigen::Index s = 0; s < samples.rows(); ++s) {
+    for (std::size_t s = 0; s < n; ++s) {
+      const auto r = static_cast<Eigen::Index>(s);
       Index best = 0;
       double best_d2 = std::numeric_limits<double>::infinity();
       for (Index v = 0; v < nv; ++v) {
-        const double d2 = (original.positions.row(v) - samples.row(s)).squaredNorm();
+        const double d2 = (original.positions.row(v) - samples.row(r)).squaredNorm();
         if (d2 < best_d2) best_d2 = d2, best = v;
       }
-      out.row(s) = samples.row(s) + result.row(best) - original.positions.row(best);
+      at.vertex[s] = {best, best, best};
+      at.weight[s] = {1.0, 0.0, 0.0};
+      at.offset.row(r) = samples.row(r) - original.positions.row(best);
     }
-    return out;
+    return at;
   }
   const BodySurface surface(shell);
-  parallel_for(0, static_cast<std::size_t>(samples.rows()), 64, [&](std::size_t b, std::size_t e) {
+  parallel_for(0, n, 64, [&](std::size_t b, std::size_t e) {
     for (std::size_t s = b; s < e; ++s) {
       const auto r = static_cast<Eigen::Index>(s);
       const ClosestPoint cp = surface.closest(samples.row(r).transpose());
       const auto& t = shell.triangles[cp.triangle];
       const Vec3 a = row3(original.positions, t[0]), b1 = row3(original.positions, t[1]), c = row3(original.positions, t[2]);
-      // Barycentric coordinates of the closest point, then the same combination on the result.
+      // Barycentric coordinates of the closest point.
       const Vec3 v0 = b1 - a, v1 = c - a, v2 = cp.point - a;
       const double d00 = v0.dot(v0), d01 = v0.dot(v1), d11 = v1.dot(v1), d20 = v2.dot(v0), d21 = v2.dot(v1);
       const double den = d00 * d11 - d01 * d01;
       const double v = den != 0.0 ? (d11 * d20 - d01 * d21) / den : 0.0, w = den != 0.0 ? (d00 * d21 - d01 * d20) / den : 0.0;
-      const Vec3 on = (1.0 - v - w) * row3(result, t[0]) + v * row3(result, t[1]) + w * row3(result, t[2]);
+      at.vertex[s] = t;
+      at.weight[s] = {1.0 - v - w, v, w};
       // Keep the sample's small offset from the surface as it was.
-      out.row(r) = (on + (samples.row(r).transpose() - cp.point)).transpose();
+      at.offset.row(r) = (samples.row(r).transpose() - cp.point).transpose();
     }
   });
+  return at;
+}
+
+Points carry(const SurfaceAttachment& at, const Points& result) {
+  Points out(at.offset.rows(), 3);
+  for (Eigen::Index r = 0; r < out.rows(); ++r) {
+    const auto s = static_cast<std::size_t>(r);
+    Vec3 q = at.offset.row(r).transpose();
+    for (int k = 0; k < 3; ++k) q += at.weight[s][k] * row3(result, at.vertex[s][k]);
+    out.row(r) = q.transpose();
+  }
   return out;
+}
+
+Points carry_points(const Garment& original, const Points& result, const Points& samples) {
+  return carry(attach_points(original, samples), result);
 }
 
 std::vector<FeatureCurveInput> feature_curve_inputs(const Garment& original, const Points& result, const BodyMesh& a,

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -109,10 +110,22 @@ double profile_straightness(const Points& curve, const Points& original, bool cl
 /// straightness). Throws as profile_straightness.
 CurveScores score_curve(const Points& curve, const Points& original, bool closed);
 
-/// Points on the original garment's faces (each sample's closest point on the
-/// fan-triangulated faces, as barycentric coordinates) carried to `result` (same
-/// vertex order): the same material points on the result. A garment without
-/// faces carries each sample by its nearest vertex's displacement.
+/// Where points sit on a garment: each point's closest point on the
+/// fan-triangulated faces (three vertices and barycentric weights) plus its small
+/// offset from there. A garment without faces uses each point's nearest vertex.
+struct SurfaceAttachment {
+  std::vector<std::array<Index, 3>> vertex;
+  std::vector<std::array<double, 3>> weight;
+  Points offset;
+};
+
+/// Attaches `samples` to the original garment (bind once).
+SurfaceAttachment attach_points(const Garment& original, const Points& samples);
+
+/// The attached points on another state of the garment (same vertex order).
+Points carry(const SurfaceAttachment& attachment, const Points& result);
+
+/// attach_points then carry: the same material points on the result.
 Points carry_points(const Garment& original, const Points& result, const Points& samples);
 
 /// Feature curves of `specs` on the original (features module), the warp alone

@@ -1,5 +1,4 @@
 #include <refit/body/body_surface.hpp>
-#include <refit/body/centre_tree.hpp>
 #include <refit/core/error.hpp>
 #include <refit/features/curve_metrics.hpp>
 #include <refit/features/feature_curves.hpp>
@@ -52,53 +51,6 @@ nlohmann::json surface_report(const SurfaceStats& s) {
             {"reconstruct", s.ms.reconstruct}}}};
 }
 
-// Where the output garment puts each feature sample: the sample follows the
-// inverse-distance blend of its nearest original vertices, so the reported
-// output shape error measures the written surface, not the optimised curve.
-struct SampleAttachment {
-  std::vector<std::array<Index, 4>> vertex;
-  std::vector<std::array<double, 4>> weight;
-  Points offset;
-};
-
-SampleAttachment attach(const PointTree& tree, const Points& original, const Points& samples) {
-  SampleAttachment a;
-  const auto n = samples.rows();
-  a.vertex.resize(static_cast<std::size_t>(n));
-  a.weight.resize(static_cast<std::size_t>(n));
-  a.offset.resize(n, 3);
-  std::vector<Index> idx;
-  std::vector<double> d2;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const Vec3 p = samples.row(i).transpose();
-    tree.knn(p, 4, idx, d2);
-    double wsum = 0;
-    Vec3 blend = Vec3::Zero();
-    for (std::size_t k = 0; k < 4; ++k) {
-      const std::size_t j = std::min(k, idx.size() - 1);
-      a.vertex[i][k] = idx[j];
-      a.weight[i][k] = 1.0 / (1e-12 + d2[j]);
-      wsum += a.weight[i][k];
-    }
-    for (std::size_t k = 0; k < 4; ++k) {
-      a.weight[i][k] /= wsum;
-      blend += a.weight[i][k] * row3(original, a.vertex[i][k]);
-    }
-    a.offset.row(i) = (p - blend).transpose();
-  }
-  return a;
-}
-
-Points place(const SampleAttachment& a, const Points& positions) {
-  Points out(a.offset.rows(), 3);
-  for (Eigen::Index i = 0; i < out.rows(); ++i) {
-    Vec3 q = a.offset.row(i).transpose();
-    for (std::size_t k = 0; k < 4; ++k) q += a.weight[i][k] * row3(positions, a.vertex[i][k]);
-    out.row(i) = q.transpose();
-  }
-  return out;
-}
-
 }  // namespace
 
 nlohmann::json garment_summary(const Garment& g) {
@@ -129,6 +81,8 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
     clock.reset();
     progress.stage("sampling " + std::to_string(features.size()) + " feature curves");
     features_ = bind_features(body_a_, build_feature_curves(*garment_, features), options_.shape_matching);
+    if (options_.stage == Stage::Full)
+      for (const FeatureCurve& c : features_->model.curves) feature_attachments_.push_back(attach_points(*garment_, c.samples));
     bind_report_["features"] = clock.ms();
   }
   if (options_.stage == Stage::Full) {
@@ -221,15 +175,10 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
                                 " iterations with update " + std::to_string(s.stats.final_update));
 
     // How the written surface carries each feature (not just the optimised curve).
-    if (features_) {
-      const PointTree tree(garment_->positions);
-      auto& list = report["features"];
-      for (std::size_t i = 0; i < curves.curves.size(); ++i) {
-        const CurveResult& c = curves.curves[i];
-        const SampleAttachment at = attach(tree, garment_->positions, c.original);
-        const Points on_output = place(at, result.positions);
-        list[i]["shape_error_output"] = shape_error(on_output, c.original, c.closed);
-      }
+    auto& list = report["features"];
+    for (std::size_t i = 0; i < curves.curves.size(); ++i) {
+      const CurveResult& c = curves.curves[i];
+      list[i]["shape_error_output"] = shape_error(carry(feature_attachments_[i], result.positions), c.original, c.closed);
     }
   }
   if (!result.positions.allFinite()) throw Error("internal: the surface step produced a non-finite position");

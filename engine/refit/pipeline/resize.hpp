@@ -7,6 +7,7 @@
 #include <refit/core/progress.hpp>
 #include <refit/features/feature_file.hpp>
 #include <refit/features/shape_matching.hpp>
+#include <refit/metrics/metrics.hpp>
 #include <refit/surface/surface.hpp>
 #include <refit/warp/warp.hpp>
 
@@ -68,6 +69,7 @@ class GarmentBinding {
   WarpBinding warp_;
   std::optional<FeatureBinding> features_;
   std::optional<SurfaceBinding> surface_;
+  std::vector<SurfaceAttachment> feature_attachments_;  // where each feature's samples sit on the garment
   nlohmann::json bind_report_;
 };
 
