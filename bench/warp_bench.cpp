@@ -1,7 +1,9 @@
 // Warp throughput: bind (body A k-d tree queries, eq. 2 sets) and apply (eq. 4
 // blend on body B) separately, for 10k to 4M-vertex procedural dresses around
-// a ~26k-triangle mannequin, with 1 and 2 threads.
+// a ~26k-triangle mannequin, with 1 and 2 threads, at the default cap
+// (WarpOptions::max_triangles).
 //   build/release/bench/warp_bench --benchmark_counters_tabular=true
+// Peak memory of a whole warp run: bench/scalability.py --stage warp.
 #include "mannequin/mannequin.hpp"
 
 #include <refit/core/parallel.hpp>
@@ -38,8 +40,14 @@ void BM_Bind(benchmark::State& state) {
   const Fixture& f = fixture(static_cast<std::size_t>(state.range(0)));
   ThreadLimit limit(static_cast<std::size_t>(state.range(1)));
   const ReferenceBody ref(f.a);
-  for (auto _ : state) benchmark::DoNotOptimize(ref.bind(f.garment.positions));
+  std::size_t pairs = 0;
+  for (auto _ : state) {
+    const WarpBinding b = ref.bind(f.garment.positions);
+    pairs = b.triangles.indices.size();
+    benchmark::DoNotOptimize(b.triangles.indices.data());
+  }
   state.counters["vertices"] = static_cast<double>(f.garment.vertex_count());
+  state.counters["triangles_per_vertex"] = static_cast<double>(pairs) / static_cast<double>(f.garment.vertex_count());
   state.counters["triangles"] = static_cast<double>(f.a.triangles.size());
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(f.garment.vertex_count()));
 }

@@ -3,6 +3,7 @@
 #include <nanoflann.hpp>
 
 #include <algorithm>
+#include <limits>
 
 namespace refit {
 
@@ -18,6 +19,44 @@ struct Cloud {
   bool kdtree_get_bbox(B&) const { return false; }
 };
 using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud, 3, Index>;
+
+// nanoflann result set for eq. 2: nanoflann's KNNResultSet (same insertion, so
+// the same order among equal distances), but the search radius is also cut to
+// scale2 times the nearest distance found so far, and to an optional bound known
+// up front. Everything cut lies outside the final set.
+class ScaledNearestSet {
+ public:
+  ScaledNearestSet(Index* idx, double* d2, std::size_t capacity, double scale2, double bound2)
+      : idx_(idx), d2_(d2), capacity_(capacity), scale2_(scale2), bound2_(bound2) {}
+  std::size_t size() const { return count_; }
+  bool full() const { return count_ == capacity_; }
+  bool addPoint(double dist, Index index) {
+    std::size_t i = count_;
+    for (; i > 0 && d2_[i - 1] > dist; --i)
+      if (i < capacity_) {
+        d2_[i] = d2_[i - 1];
+        idx_[i] = idx_[i - 1];
+      }
+    if (i < capacity_) {
+      d2_[i] = dist;
+      idx_[i] = index;
+    }
+    if (count_ < capacity_) ++count_;
+    return true;
+  }
+  double worstDist() const {
+    double w = bound2_;
+    if (count_ > 0) w = std::min(w, scale2_ * d2_[0]);
+    if (count_ == capacity_) w = std::min(w, d2_[capacity_ - 1]);
+    return w;
+  }
+
+ private:
+  Index* idx_;
+  double* d2_;
+  std::size_t capacity_, count_ = 0;
+  double scale2_, bound2_;
+};
 }  // namespace
 
 struct PointTree::Impl {
@@ -62,6 +101,37 @@ void PointTree::knn(const Vec3& p, std::size_t k, std::vector<Index>& idx, std::
   impl_->tree->findNeighbors(rs, p.data(), nanoflann::SearchParams());
   idx.resize(rs.size());
   dist2.resize(rs.size());
+  for (auto& i : idx) i = impl_->cloud.id[i];
+}
+
+void PointTree::nearest_within_scaled(const Vec3& p, std::size_t k, double scale2, std::vector<Index>& idx,
+                                      std::vector<double>& dist2, std::span<const Vec3> hint) const {
+  k = std::min(k, size());
+  idx.resize(k);
+  dist2.resize(k);
+  if (k == 0) return;
+  // Squared distances to the hints, kept in dist2 (overwritten by the search).
+  double bound2 = std::numeric_limits<double>::infinity();
+  if (!hint.empty()) {
+    std::vector<double>& h = dist2;
+    h.resize(std::max(k, hint.size()));
+    for (std::size_t j = 0; j < hint.size(); ++j) h[j] = (p - hint[j]).squaredNorm();
+    bound2 = scale2 * *std::min_element(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(hint.size()));
+    if (hint.size() >= k) {
+      std::nth_element(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(k - 1), h.begin() + static_cast<std::ptrdiff_t>(hint.size()));
+      bound2 = std::min(bound2, h[k - 1]);
+    }
+    // Relative slack: a point whose distance nanoflann rounds differently from
+    // this one stays inside the search.
+    bound2 = bound2 * (1.0 + 1e-9) + 1e-300;
+    dist2.resize(k);
+  }
+  ScaledNearestSet rs(idx.data(), dist2.data(), k, scale2, bound2);
+  impl_->tree->findNeighbors(rs, p.data(), nanoflann::SearchParams());
+  std::size_t m = std::min<std::size_t>(1, rs.size());
+  while (m < rs.size() && dist2[m] < scale2 * dist2[0]) ++m;
+  idx.resize(m);
+  dist2.resize(m);
   for (auto& i : idx) i = impl_->cloud.id[i];
 }
 

@@ -4,6 +4,7 @@
 #include <refit/core/types.hpp>
 
 #include <memory>
+#include <span>
 #include <vector>
 
 namespace refit {
@@ -23,6 +24,17 @@ class PointTree {
   void knn(const Vec3& p, std::size_t k, std::vector<Index>& idx, std::vector<double>& dist2) const;
   /// All points with squared distance < r2, closest first.
   void within(const Vec3& p, double r2, std::vector<std::pair<Index, double>>& out) const;
+  /// The eq. 2 set of the warp (paper section 3), capped: of the k nearest points,
+  /// those with squared distance < scale2 * (the nearest's squared distance),
+  /// closest first (the nearest always counts; fewer than k when the radius or the
+  /// tree runs out). One search whose pruning radius shrinks with the nearest point
+  /// found so far. `hint`: distinct points of the tree thought to be near p (e.g.
+  /// the previous query's set); they bound the radius before the search starts
+  /// (scale2 times the nearest hint's squared distance, and with k or more hints
+  /// the k-th nearest hint's). The hint only prunes: the result is the same
+  /// with or without it.
+  void nearest_within_scaled(const Vec3& p, std::size_t k, double scale2, std::vector<Index>& idx,
+                             std::vector<double>& dist2, std::span<const Vec3> hint = {}) const;
 
  private:
   struct Impl;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <tuple>
@@ -31,9 +32,18 @@ Vec3 crossing(const Points& p, const std::vector<double>& s, Index i, Index j) {
   return row3(p, i) + t * (row3(p, j) - row3(p, i));
 }
 
+// The coordinates mixed (xor of odd multiples, then a 64-bit finaliser): the
+// plain xor of multiples puts whole rows of a regular grid of cells into a few
+// buckets, which made welding a 1M-vertex garment take seconds.
 struct CellHash {
   std::size_t operator()(const std::array<std::int64_t, 3>& k) const {
-    return static_cast<std::size_t>(k[0] * 73856093LL ^ k[1] * 19349663LL ^ k[2] * 83492791LL);
+    std::uint64_t h = static_cast<std::uint64_t>(k[0]) * 0x9E3779B97F4A7C15ULL ^
+                      static_cast<std::uint64_t>(k[1]) * 0xC2B2AE3D27D4EB4FULL ^
+                      static_cast<std::uint64_t>(k[2]) * 0x165667B19E3779F9ULL;
+    h ^= h >> 32;
+    h *= 0xD6E8FEB86659FD93ULL;
+    h ^= h >> 32;
+    return static_cast<std::size_t>(h);
   }
 };
 
@@ -47,31 +57,73 @@ double bounding_box_diagonal(const Points& p) {
 std::vector<Index> weld_points(const Points& p, double tol) {
   const std::size_t n = static_cast<std::size_t>(p.rows());
   std::vector<Index> rep(n);
-  if (!(tol > 0.0)) {
-    for (std::size_t i = 0; i < n; ++i) rep[i] = static_cast<Index>(i);
-    return rep;
-  }
+  for (std::size_t i = 0; i < n; ++i) rep[i] = static_cast<Index>(i);
+  if (!(tol > 0.0) || n < 2) return rep;
+
+  // Cells of 4 tol: the tol-box around a point touches 1 or 2 cells per axis
+  // (about 3.4 in all, not 27).
+  const double cell = 4.0 * tol, reach = 1.01 * tol;
+  const double inv = 1.0 / cell;
+  const auto cell_of = [inv](double v) { return static_cast<std::int64_t>(std::floor(v * inv)); };
+  const auto box = [&](std::size_t i, auto&& visit) {
+    const auto r = static_cast<Eigen::Index>(i);
+    std::int64_t lo[3], hi[3];
+    for (int c = 0; c < 3; ++c) lo[c] = cell_of(p(r, c) - reach), hi[c] = cell_of(p(r, c) + reach);
+    for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
+      for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+        for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
+          if (!visit(std::array<std::int64_t, 3>{x, y, z})) return;
+  };
+  const auto own_cell = [&](std::size_t i) {
+    const auto r = static_cast<Eigen::Index>(i);
+    return std::array<std::int64_t, 3>{cell_of(p(r, 0)), cell_of(p(r, 1)), cell_of(p(r, 2))};
+  };
+
+  // 1. Which points may have another point within tol, in parallel: occupied
+  // cells hashed into bit sets ("one point", "two or more") of 64 bits per point,
+  // so a collision (which only adds a candidate, never loses one) is rare. Most
+  // points of a garment have no twin and are done here.
+  std::size_t bits = 1 << 16;
+  while (bits < 64 * n) bits *= 2;
+  const std::size_t mask = bits - 1;
+  std::vector<std::atomic<std::uint64_t>> once(bits / 64), twice(bits / 64);
+  parallel_for(0, n, 1 << 14, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      const std::size_t h = CellHash{}(own_cell(i)) & mask;
+      const std::uint64_t bit = std::uint64_t(1) << (h % 64);
+      if (once[h / 64].fetch_or(bit, std::memory_order_relaxed) & bit) twice[h / 64].fetch_or(bit, std::memory_order_relaxed);
+    }
+  });
+  std::vector<std::uint8_t> candidate(n, 0);
+  parallel_for(0, n, 1 << 14, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      const auto own = own_cell(i);
+      box(i, [&](const std::array<std::int64_t, 3>& k) {
+        const std::size_t h = CellHash{}(k) & mask;
+        const std::uint64_t bit = std::uint64_t(1) << (h % 64);
+        const auto& set = k == own ? twice : once;  // its own cell counts only with another point in it
+        candidate[i] = (set[h / 64].load(std::memory_order_relaxed) & bit) ? 1 : 0;
+        return !candidate[i];
+      });
+    }
+  });
+
+  // 2. The candidates, in row order: each joins the lowest-numbered
+  // representative within tol, or becomes one.
   std::unordered_map<std::array<std::int64_t, 3>, std::vector<Index>, CellHash> grid;
-  grid.reserve(n);
   const double tol2 = tol * tol;
   for (std::size_t i = 0; i < n; ++i) {
-    std::array<std::int64_t, 3> key;
-    for (int c = 0; c < 3; ++c) key[c] = static_cast<std::int64_t>(std::floor(p(static_cast<Eigen::Index>(i), c) / tol));
+    if (!candidate[i]) continue;
     Index found = static_cast<Index>(i);
-    for (int dx = -1; dx <= 1 && found == i; ++dx)
-      for (int dy = -1; dy <= 1 && found == i; ++dy)
-        for (int dz = -1; dz <= 1 && found == i; ++dz) {
-          auto it = grid.find({key[0] + dx, key[1] + dy, key[2] + dz});
-          if (it == grid.end()) continue;
-          for (Index r : it->second) {
-            if ((p.row(r) - p.row(static_cast<Eigen::Index>(i))).squaredNorm() <= tol2) {
-              found = r;
-              break;
-            }
-          }
-        }
+    box(i, [&](const std::array<std::int64_t, 3>& k) {
+      const auto it = grid.find(k);
+      if (it != grid.end())
+        for (Index r : it->second)
+          if (r < found && (p.row(r) - p.row(static_cast<Eigen::Index>(i))).squaredNorm() <= tol2) found = r;
+      return true;
+    });
     rep[i] = found;
-    if (found == i) grid[key].push_back(found);
+    if (found == i) grid[own_cell(i)].push_back(found);
   }
   return rep;
 }

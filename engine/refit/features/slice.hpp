@@ -25,9 +25,12 @@ struct SliceResult {
 /// Diagonal of the axis-aligned bounding box of the rows (0 when empty).
 double bounding_box_diagonal(const Points& p);
 
-/// Welds points closer than `tolerance` (grid hashing, in row order): returns, per
-/// row, the index of its representative (the first row of its cluster), so the
-/// result is deterministic.
+/// Welds points closer than `tolerance` (grid hashing): returns, per row, the index
+/// of its representative: in row order, each point joins the lowest-numbered
+/// representative within `tolerance`, or becomes one (so a cluster's
+/// representative is its first row, and the result is deterministic). Points with
+/// no other point within `tolerance` (most of a garment) are found in parallel
+/// first; only the others go through the sequential clustering. Points must be finite.
 std::vector<Index> weld_points(const Points& p, double tolerance);
 
 /// Cuts the faces of `g` by `plane` and chains the cut segments into polylines.

@@ -9,7 +9,6 @@ namespace refit {
 
 namespace {
 constexpr std::size_t kGrain = 1024;
-constexpr std::size_t kFirstQuery = 8;
 
 // Eq. 4's weight; |(u, v, w)| = |p - c| because the frame is orthonormal.
 inline double blend_weight(const Vec3& d) {
@@ -32,28 +31,35 @@ WarpBinding ReferenceBody::bind(const Points& points) const {
   const std::size_t n = static_cast<std::size_t>(points.rows());
   const std::size_t k = options_.max_triangles;
   const double scale2 = (1.0 + options_.alpha) * (1.0 + options_.alpha);
-  // Each point's set goes to a fixed-size slot first, so the CSR built after is
-  // independent of how TBB split the range.
-  std::vector<Index> slots(n * k);
-  std::vector<std::uint8_t> counts(n);
+  // Fixed blocks of points, each with its own list: concatenated in block order,
+  // the CSR does not depend on how TBB ran them, and memory is what the sets
+  // need (not n * k slots).
+  const std::size_t blocks = (n + kGrain - 1) / kGrain;
+  std::vector<std::vector<Index>> found(blocks);
+  std::vector<Index> counts(n);
   std::vector<std::uint8_t> capped(n);
-  parallel_for(0, n, kGrain, [&](std::size_t begin, std::size_t end) {
+  parallel_for(0, blocks, 1, [&](std::size_t b0, std::size_t b1) {
     std::vector<Index> idx;
     std::vector<double> d2;
-    for (std::size_t i = begin; i < end; ++i) {
-      const Vec3 p = row3(points, static_cast<Index>(i));
-      // Near the body the eq. 2 set is small: a cheap query for a few centres
-      // usually holds all of it; only when it does not, ask for the cap.
-      tree_.knn(p, std::min(k, kFirstQuery), idx, d2);
-      // Eq. 2: centres strictly within (1+alpha)|pq| of p; the nearest always counts
-      // (a point exactly on a centre has |pq| = 0).
-      const double r2 = d2[0] * scale2;
-      if (k > kFirstQuery && idx.size() == kFirstQuery && d2.back() < r2) tree_.knn(p, k, idx, d2);
-      std::size_t m = 1;
-      while (m < idx.size() && d2[m] < r2) ++m;
-      std::copy_n(idx.begin(), m, slots.begin() + static_cast<std::ptrdiff_t>(i * k));
-      counts[i] = static_cast<std::uint8_t>(m);
-      capped[i] = (m == k && idx.size() == k) ? 1 : 0;
+    for (std::size_t blk = b0; blk < b1; ++blk) {
+      const std::size_t first = blk * kGrain, last = std::min(n, first + kGrain);
+      std::vector<Index>& out = found[blk];
+      out.reserve((last - first) * std::min<std::size_t>(k, 4));
+      // Consecutive points are usually close: the previous point's set bounds this
+      // one's search radius before the search starts (only pruning: the set is the
+      // same without it).
+      std::vector<Vec3> hint;
+      for (std::size_t i = first; i < last; ++i) {
+        const Vec3 p = row3(points, static_cast<Index>(i));
+        // Eq. 2: the (at most k) nearest centres strictly within (1+alpha)|pq| of p;
+        // the nearest always counts (a point exactly on a centre has |pq| = 0).
+        tree_.nearest_within_scaled(p, k, scale2, idx, d2, hint);
+        hint.clear();
+        for (Index t : idx) hint.push_back(row3(frames_->centre, t));
+        out.insert(out.end(), idx.begin(), idx.end());
+        counts[i] = static_cast<Index>(idx.size());
+        capped[i] = idx.size() == k ? 1 : 0;
+      }
     }
   });
   WarpBinding b;
@@ -66,10 +72,11 @@ WarpBinding ReferenceBody::bind(const Points& points) const {
     b.capped += capped[i];
   }
   b.triangles.indices.resize(b.triangles.offsets[n]);
-  parallel_for(0, n, kGrain * 8, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i)
-      std::copy_n(slots.begin() + static_cast<std::ptrdiff_t>(i * k), counts[i],
-                  b.triangles.indices.begin() + b.triangles.offsets[i]);
+  parallel_for(0, blocks, 8, [&](std::size_t b0, std::size_t b1) {
+    for (std::size_t blk = b0; blk < b1; ++blk) {
+      std::copy(found[blk].begin(), found[blk].end(), b.triangles.indices.begin() + b.triangles.offsets[blk * kGrain]);
+      std::vector<Index>().swap(found[blk]);
+    }
   });
   return b;
 }
