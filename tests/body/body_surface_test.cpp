@@ -5,6 +5,7 @@
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
 
+#include "support/shapes.hpp"
 #include "support/test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -23,43 +24,6 @@
 
 namespace refit {
 namespace {
-
-// Icosphere: subdivided icosahedron, vertices on the sphere, outward triangles.
-BodyMesh icosphere(int levels, double radius, const Vec3& centre) {
-  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Vec3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                         {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  std::vector<std::array<Index, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                                         {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                                         {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                                         {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
-  for (auto& p : v) p.normalize();
-  for (int l = 0; l < levels; ++l) {
-    std::map<std::pair<Index, Index>, Index> mid;
-    auto midpoint = [&](Index a, Index b) {
-      auto key = std::minmax(a, b);
-      auto it = mid.find(key);
-      if (it != mid.end()) return it->second;
-      v.push_back((v[a] + v[b]).normalized());
-      return mid[key] = static_cast<Index>(v.size() - 1);
-    };
-    std::vector<std::array<Index, 3>> g;
-    for (auto& tri : f) {
-      const Index a = midpoint(tri[0], tri[1]), b = midpoint(tri[1], tri[2]), c = midpoint(tri[2], tri[0]);
-      g.push_back({tri[0], a, c});
-      g.push_back({tri[1], b, a});
-      g.push_back({tri[2], c, b});
-      g.push_back({a, b, c});
-    }
-    f = std::move(g);
-  }
-  BodyMesh m;
-  m.vertices.resize(static_cast<Eigen::Index>(v.size()), 3);
-  for (std::size_t i = 0; i < v.size(); ++i) m.vertices.row(static_cast<Eigen::Index>(i)) = (centre + radius * v[i]).transpose();
-  m.triangles = f;
-  m.name = "sphere";
-  return m;
-}
 
 // Reference point-triangle distance, written differently from the engine's:
 // projection onto the plane when inside, else the nearest of the three edges.
@@ -195,7 +159,7 @@ void check_against_brute_force(const BodyMesh& m, std::size_t count, unsigned se
 TEST(BodySurface, SphereClosestAndInsideMatchAnalytic) {
   const Vec3 c(1.0, -2.0, 3.0);
   const double r = 10.0;
-  const BodyMesh m = icosphere(3, r, c);
+  const BodyMesh m = test::icosphere(3, r, c);
   // The faces lie between the inradius and r from the centre.
   double inradius = r;
   for (const auto& t : m.triangles) {
@@ -231,7 +195,7 @@ TEST(BodySurface, SphereClosestAndInsideMatchAnalytic) {
 }
 
 TEST(BodySurface, PointsOnAndNearTheSurface) {
-  const BodyMesh m = icosphere(3, 1.0, Vec3::Zero());
+  const BodyMesh m = test::icosphere(3, 1.0, Vec3::Zero());
   const BodySurface s(m);
   for (Eigen::Index v = 0; v < m.vertices.rows(); ++v) {
     const Vec3 p = m.vertices.row(v).transpose();
@@ -254,7 +218,7 @@ TEST(BodySurface, PointsOnAndNearTheSurface) {
 }
 
 TEST(BodySurface, ClosestWithinHonoursTheRadius) {
-  const BodyMesh m = icosphere(2, 1.0, Vec3::Zero());
+  const BodyMesh m = test::icosphere(2, 1.0, Vec3::Zero());
   const BodySurface s(m);
   const Vec3 p(0.0, 0.0, 1.5);
   EXPECT_TRUE(std::isinf(s.closest_within(p, 0.4).distance));
@@ -268,7 +232,7 @@ TEST(BodySurface, ClosestWithinHonoursTheRadius) {
 }
 
 TEST(BodySurface, BadBodyThrowsNamingTheFile) {
-  BodyMesh m = icosphere(1, 1.0, Vec3::Zero());
+  BodyMesh m = test::icosphere(1, 1.0, Vec3::Zero());
   m.path = "bodies/bad.obj";
   m.triangles[3][1] = 100000;
   try {
@@ -282,7 +246,7 @@ TEST(BodySurface, BadBodyThrowsNamingTheFile) {
   EXPECT_THROW(BodySurface{empty}, Error);
 }
 
-TEST(BodySurface, SphereAgainstBruteForce) { check_against_brute_force(icosphere(3, 5.0, Vec3(1, 2, 3)), 2000, 11); }
+TEST(BodySurface, SphereAgainstBruteForce) { check_against_brute_force(test::icosphere(3, 5.0, Vec3(1, 2, 3)), 2000, 11); }
 
 #ifdef REFIT_HAVE_MANNEQUIN
 TEST(BodySurface, MannequinAgainstBruteForce) {
