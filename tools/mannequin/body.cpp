@@ -1,6 +1,7 @@
 // The procedural mannequin: an analytic shape (profile keys along the height)
 // sampled into five closed tubes.
 #include "mannequin/mannequin.hpp"
+#include "mannequin/shape_math.hpp"
 
 #include <refit/core/error.hpp>
 
@@ -13,12 +14,6 @@
 namespace refit::mannequin {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
-double smoothstep(double t) {
-  t = std::clamp(t, 0.0, 1.0);
-  return t * t * (3.0 - 2.0 * t);
-}
 
 /// Perimeter of the ellipse with half axes 1 and k (Ramanujan; error < 1e-4 here).
 double unit_ellipse_perimeter(double k) {

@@ -1,6 +1,7 @@
 // Procedural garments around the analytic mannequin: quad grids whose rows are
 // horizontal rings outside the body's cross-section at their height.
 #include "mannequin/mannequin.hpp"
+#include "mannequin/shape_math.hpp"
 
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
@@ -14,12 +15,6 @@
 namespace refit::mannequin {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
-double smoothstep(double t) {
-  t = std::clamp(t, 0.0, 1.0);
-  return t * t * (3.0 - 2.0 * t);
-}
 
 /// Directions (cos phi, sin phi) = (x, z) of N columns, phi_k = pi/2 - 2 pi k/N:
 /// column 0 is the front centre, N/4 the left side, N/2 the back, 3N/4 the right

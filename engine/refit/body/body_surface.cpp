@@ -2,6 +2,7 @@
 // triangles and ray hits; every distance and every inside/outside decision near
 // the surface is made in double on the body's own positions.
 #include <refit/body/body_surface.hpp>
+#include <refit/body/embree_ray.hpp>
 #include <refit/core/error.hpp>
 
 #include <embree3/rtcore.h>
@@ -214,21 +215,7 @@ struct BodySurface::Impl {
     c.ctx.filter = collect_filter;
     c.face_normal = &face_normal;
     c.dir = dir;
-    RTCRayHit rh;
-    rh.ray.org_x = static_cast<float>(p.x());
-    rh.ray.org_y = static_cast<float>(p.y());
-    rh.ray.org_z = static_cast<float>(p.z());
-    rh.ray.dir_x = static_cast<float>(dir.x());
-    rh.ray.dir_y = static_cast<float>(dir.y());
-    rh.ray.dir_z = static_cast<float>(dir.z());
-    rh.ray.tnear = 0.0f;
-    rh.ray.tfar = std::numeric_limits<float>::infinity();
-    rh.ray.time = 0.0f;
-    rh.ray.mask = 0xFFFFFFFFu;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    RTCRayHit rh = make_ray(p, dir);
     rtcIntersect1(scene, &c.ctx, &rh);
     if (c.overflow) return -1;
     std::sort(c.hits.begin(), c.hits.begin() + c.count, [](const RayHit& a, const RayHit& b) {
@@ -502,21 +489,7 @@ double BodySurface::signed_distance(const Vec3& p) const {
 double BodySurface::intersect(const Vec3& origin, const Vec3& dir, Index* tri_out) const {
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  RTCRayHit rh;
-  rh.ray.org_x = static_cast<float>(origin.x());
-  rh.ray.org_y = static_cast<float>(origin.y());
-  rh.ray.org_z = static_cast<float>(origin.z());
-  rh.ray.dir_x = static_cast<float>(dir.x());
-  rh.ray.dir_y = static_cast<float>(dir.y());
-  rh.ray.dir_z = static_cast<float>(dir.z());
-  rh.ray.tnear = 0.0f;
-  rh.ray.tfar = std::numeric_limits<float>::infinity();
-  rh.ray.time = 0.0f;
-  rh.ray.mask = 0xFFFFFFFFu;
-  rh.ray.id = 0;
-  rh.ray.flags = 0;
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+  RTCRayHit rh = make_ray(origin, dir);
   rtcIntersect1(impl_->scene, &ctx, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return kInf;
   if (tri_out) *tri_out = rh.hit.primID;

@@ -1,4 +1,5 @@
 #include <refit/metrics/render.hpp>
+#include <refit/body/embree_ray.hpp>
 
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
@@ -185,20 +186,7 @@ Image render(const BodyMesh& body, const Garment& garment, const Garment* garmen
           const double u = (x - p.x0 + 0.5 - 0.5 * p.width) * pixel[pi];
           const double v = (0.5 * img.height - (static_cast<double>(y) + 0.5)) * pixel[pi];
           const Vec3 o = centre + u * c.right + v * c.up - depth * c.forward;
-          RTCRayHit rh;
-          rh.ray.org_x = static_cast<float>(o.x());
-          rh.ray.org_y = static_cast<float>(o.y());
-          rh.ray.org_z = static_cast<float>(o.z());
-          rh.ray.dir_x = static_cast<float>(c.forward.x());
-          rh.ray.dir_y = static_cast<float>(c.forward.y());
-          rh.ray.dir_z = static_cast<float>(c.forward.z());
-          rh.ray.tnear = 0.0f;
-          rh.ray.tfar = std::numeric_limits<float>::infinity();
-          rh.ray.time = 0.0f;
-          rh.ray.mask = 0xFFFFFFFFu;
-          rh.ray.id = 0;
-          rh.ray.flags = 0;
-          rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+          RTCRayHit rh = make_ray(o, c.forward);
           rtcIntersect1(scenes[static_cast<std::size_t>(p.garment)]->get(), &ctx, &rh);
           if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
           Vec3 n(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
