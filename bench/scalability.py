@@ -33,7 +33,7 @@ def main():
     A, B = os.path.join(work, "A.obj"), os.path.join(work, "B.obj")
     run([a.refit, "generate", "--body-out", A])
     run([a.refit, "generate", "--belly", "6", "--hip", "104", "--waist", "76", "--bust", "92", "--body-out", B])
-    stages = ["load", "bind", "warp", "features", "surface", "write", "total"]
+    stages = ["load", "bind", "warp", "features", "surface", "collision", "write", "total"]
     print(f"stage: {a.stage}; medians of {a.repeat} runs; ms except memory")
     print("| vertices | threads | " + " | ".join(stages) + " | peak MB | bytes/vertex |")
     print("|" + "---:|" * (len(stages) + 4))
