@@ -451,6 +451,10 @@ BodySurface::BodySurface(const BodyMesh& body) : impl_(std::make_unique<Impl>())
   if (rtcGetDeviceError(m.device) != RTC_ERROR_NONE) throw Error("Embree: building the scene of " + file + " failed");
 }
 
+Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  return closest_on_triangle(p, a, b, c).point;
+}
+
 BodySurface::~BodySurface() = default;
 BodySurface::BodySurface(BodySurface&&) noexcept = default;
 BodySurface& BodySurface::operator=(BodySurface&&) noexcept = default;

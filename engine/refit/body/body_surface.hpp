@@ -14,6 +14,9 @@ struct ClosestPoint {
   Index triangle = 0;
 };
 
+/// Closest point to p on triangle abc (exact, in double).
+Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+
 class BodySurface {
  public:
   explicit BodySurface(const BodyMesh& body);

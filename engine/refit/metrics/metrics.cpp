@@ -1,5 +1,6 @@
 #include <refit/metrics/metrics.hpp>
 
+#include <refit/body/centre_tree.hpp>
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
 #include <refit/features/bspline.hpp>
@@ -216,53 +217,104 @@ ResizeMetrics compute_metrics(const Garment& original, const Points& result, con
   return compute_metrics(original, result, sa, sb, options);
 }
 
+namespace {
+
+// Best candidate per sample, kept per chunk of work and merged in chunk order so
+// the result does not depend on how the work was split.
+struct Candidate {
+  double d2 = std::numeric_limits<double>::infinity();
+  std::array<Index, 3> vertex{};
+  std::array<double, 3> weight{};
+  Vec3 point = Vec3::Zero();
+};
+
+std::vector<Candidate> merge_chunks(const std::vector<std::vector<Candidate>>& chunks, std::size_t n) {
+  std::vector<Candidate> best(n);
+  for (const auto& chunk : chunks)
+    for (std::size_t s = 0; s < n; ++s)
+      if (chunk[s].d2 < best[s].d2) best[s] = chunk[s];
+  return best;
+}
+
+constexpr std::size_t kChunk = 1 << 16;
+
+}  // namespace
+
 SurfaceAttachment attach_points(const Garment& original, const Points& samples) {
-  const Index nv = static_cast<Index>(original.positions.rows());
-  const auto n = static_cast<std::size_t>(samples.rows());
+  const std::size_t nv = original.vertex_count(), n = static_cast<std::size_t>(samples.rows());
   SurfaceAttachment at;
   at.vertex.resize(n);
   at.weight.resize(n);
   at.offset.resize(samples.rows(), 3);
-  BodyMesh shell;  // the garment's faces as a triangle soup for Embree's closest-point query
-  shell.vertices = original.positions;
-  shell.name = "garment";
-  for (std::size_t f = 0; f < original.faces.rows(); ++f) {
-    const auto face = original.faces.row(f);
-    for (std::size_t k = 1; k + 1 < face.size(); ++k) shell.triangles.push_back({face[0], face[k], face[k + 1]});
-  }
-  if (shell.triangles.empty()) {
-    for (std::size_t s = 0; s < n; ++s) {
-      const auto r = static_cast<Eigen::Index>(s);
-      Index best = 0;
-      double best_d2 = std::numeric_limits<double>::infinity();
-      for (Index v = 0; v < nv; ++v) {
-        const double d2 = (original.positions.row(v) - samples.row(r)).squaredNorm();
-        if (d2 < best_d2) best_d2 = d2, best = v;
+  if (n == 0 || nv == 0) return at;
+  const auto sample = [&](std::size_t s) { return Vec3(samples.row(static_cast<Eigen::Index>(s)).transpose()); };
+
+  // 1. Each sample's nearest vertex: every vertex asks the small tree of samples
+  // which one is nearest, and each sample keeps the nearest vertex that chose it.
+  // Linear in the garment, so attaching stays cheap at millions of vertices.
+  const PointTree tree(samples);
+  const std::size_t vchunks = (nv + kChunk - 1) / kChunk;
+  std::vector<std::vector<Candidate>> per_chunk(vchunks, std::vector<Candidate>(n));
+  parallel_for(0, vchunks, 1, [&](std::size_t cb, std::size_t ce) {
+    for (std::size_t c = cb; c < ce; ++c)
+      for (std::size_t v = c * kChunk; v < std::min(nv, (c + 1) * kChunk); ++v) {
+        const Vec3 p = row3(original.positions, static_cast<Index>(v));
+        const auto [s, d2] = tree.nearest(p);
+        Candidate& best = per_chunk[c][s];
+        if (d2 < best.d2) best = {d2, {Index(v), Index(v), Index(v)}, {1.0, 0.0, 0.0}, p};
       }
-      at.vertex[s] = {best, best, best};
-      at.weight[s] = {1.0, 0.0, 0.0};
-      at.offset.row(r) = samples.row(r) - original.positions.row(best);
-    }
-    return at;
-  }
-  const BodySurface surface(shell);
-  parallel_for(0, n, 64, [&](std::size_t b, std::size_t e) {
-    for (std::size_t s = b; s < e; ++s) {
-      const auto r = static_cast<Eigen::Index>(s);
-      const ClosestPoint cp = surface.closest(samples.row(r).transpose());
-      const auto& t = shell.triangles[cp.triangle];
-      const Vec3 a = row3(original.positions, t[0]), b1 = row3(original.positions, t[1]), c = row3(original.positions, t[2]);
-      // Barycentric coordinates of the closest point.
-      const Vec3 v0 = b1 - a, v1 = c - a, v2 = cp.point - a;
-      const double d00 = v0.dot(v0), d01 = v0.dot(v1), d11 = v1.dot(v1), d20 = v2.dot(v0), d21 = v2.dot(v1);
-      const double den = d00 * d11 - d01 * d01;
-      const double v = den != 0.0 ? (d11 * d20 - d01 * d21) / den : 0.0, w = den != 0.0 ? (d00 * d21 - d01 * d20) / den : 0.0;
-      at.vertex[s] = t;
-      at.weight[s] = {1.0 - v - w, v, w};
-      // Keep the sample's small offset from the surface as it was.
-      at.offset.row(r) = (samples.row(r).transpose() - cp.point).transpose();
-    }
   });
+  std::vector<Candidate> nearest = merge_chunks(per_chunk, n);
+  for (std::size_t s = 0; s < n; ++s) {
+    if (std::isfinite(nearest[s].d2)) continue;  // every vertex was nearer another sample
+    for (std::size_t v = 0; v < nv; ++v) {
+      const Vec3 p = row3(original.positions, static_cast<Index>(v));
+      const double d2 = (p - sample(s)).squaredNorm();
+      if (d2 < nearest[s].d2) nearest[s] = {d2, {Index(v), Index(v), Index(v)}, {1.0, 0.0, 0.0}, p};
+    }
+  }
+
+  // 2. The closest point on the (fan-triangulated) faces around that vertex.
+  std::vector<std::int64_t> first(nv, -1), next(n, -1);  // samples attached to each vertex, chained
+  for (std::size_t s = n; s-- > 0;) {
+    const Index v = nearest[s].vertex[0];
+    next[s] = first[v];
+    first[v] = static_cast<std::int64_t>(s);
+  }
+  const std::size_t nf = original.faces.rows(), fchunks = (nf + kChunk - 1) / kChunk;
+  per_chunk.assign(fchunks, std::vector<Candidate>(n));
+  parallel_for(0, fchunks, 1, [&](std::size_t cb, std::size_t ce) {
+    for (std::size_t c = cb; c < ce; ++c)
+      for (std::size_t f = c * kChunk; f < std::min(nf, (c + 1) * kChunk); ++f) {
+        const auto face = original.faces.row(f);
+        for (Index corner : face)
+          for (std::int64_t s = first[corner]; s >= 0; s = next[static_cast<std::size_t>(s)])
+            for (std::size_t k = 1; k + 1 < face.size(); ++k) {
+              const std::array<Index, 3> t{face[0], face[k], face[k + 1]};
+              const Vec3 a = row3(original.positions, t[0]), b = row3(original.positions, t[1]),
+                         cc = row3(original.positions, t[2]);
+              const Vec3 q = closest_point_on_triangle(sample(static_cast<std::size_t>(s)), a, b, cc);
+              const double d2 = (q - sample(static_cast<std::size_t>(s))).squaredNorm();
+              Candidate& best = per_chunk[c][static_cast<std::size_t>(s)];
+              if (!(d2 < best.d2)) continue;
+              // Barycentric coordinates of q in abc.
+              const Vec3 v0 = b - a, v1 = cc - a, v2 = q - a;
+              const double d00 = v0.dot(v0), d01 = v0.dot(v1), d11 = v1.dot(v1), d20 = v2.dot(v0), d21 = v2.dot(v1);
+              const double den = d00 * d11 - d01 * d01;
+              const double wv = den != 0.0 ? (d11 * d20 - d01 * d21) / den : 0.0;
+              const double ww = den != 0.0 ? (d00 * d21 - d01 * d20) / den : 0.0;
+              best = {d2, t, {1.0 - wv - ww, wv, ww}, q};
+            }
+      }
+  });
+  const std::vector<Candidate> on_faces = merge_chunks(per_chunk, n);
+  for (std::size_t s = 0; s < n; ++s) {
+    const Candidate& c = std::isfinite(on_faces[s].d2) ? on_faces[s] : nearest[s];  // no face: the vertex itself
+    at.vertex[s] = c.vertex;
+    at.weight[s] = c.weight;
+    // Keep the sample's small offset from the surface as it was.
+    at.offset.row(static_cast<Eigen::Index>(s)) = (sample(s) - c.point).transpose();
+  }
   return at;
 }
 
