@@ -59,6 +59,11 @@ Csr build_csr(std::size_t n, std::size_t chunk, RowFn&& row_fn) {
 }  // namespace
 
 SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, const SurfaceOptions& options) {
+  return bind_level(g, features, options, nullptr);
+}
+
+SurfaceBinding SurfaceBinding::bind_level(const Garment& g, const Points& features, const SurfaceOptions& options,
+                                          const SurfaceBinding* finer) {
   check_options(options);
   check_finite(features, "feature sample");
   SurfaceBinding s;
@@ -172,21 +177,26 @@ SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, co
     const PointTree tree(s.original_agents_);
     const double r2 = std::pow(options.reach_voxels * s.h_, 2);
     std::vector<std::uint8_t> capped(nv, 0);
+    // The nearest max_reach_agents, then the reach radius: a bounded k-nearest
+    // query costs far less than collecting every agent within reach and cutting.
     s.reach_ = build_csr(nv, 4096, [&](std::size_t v, std::vector<Index>& row) {
-      thread_local std::vector<std::pair<Index, double>> found;
+      thread_local std::vector<Index> idx;
+      thread_local std::vector<double> d2;
       const Vec3 p = row3(g.positions, Index(v));
-      tree.within(p, r2, found);
-      if (found.size() > options.max_reach_agents) {
-        found.resize(options.max_reach_agents);
-        capped[v] = 1;
-      }
-      for (const auto& f : found) row.push_back(f.first);
-      s.nearest_[v] = found.empty() ? tree.nearest(p).first : found.front().first;
+      tree.knn(p, options.max_reach_agents + 1, idx, d2);
+      std::size_t m = 0;
+      while (m < idx.size() && m < options.max_reach_agents && d2[m] < r2) ++m;
+      capped[v] = m == options.max_reach_agents && idx.size() > m && d2[m] < r2;
+      row.insert(row.end(), idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(m));
+      s.nearest_[v] = idx.empty() ? 0 : idx.front();
     });
     st.vertices_capped = std::accumulate(capped.begin(), capped.end(), std::size_t{0});
     for (std::size_t v = 0; v < nv; ++v) st.vertices_without_agent += s.reach_.row_size(v) == 0;
     // Feature samples without a warped position move with their nearest vertex.
-    if (nf > 0 && nv > 0) {
+    if (finer) {  // the same garment and samples: reuse the finer level's attachment
+      s.feature_vertex_ = finer->feature_vertex_;
+      s.feature_offset_ = finer->feature_offset_;
+    } else if (nf > 0 && nv > 0) {
       const PointTree vtree(g.positions);
       s.feature_vertex_.resize(nf);
       s.feature_offset_.resize(static_cast<Eigen::Index>(nf), 3);
@@ -204,8 +214,9 @@ SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, co
     SurfaceOptions co = options;
     co.voxel = 2.0 * s.h_;
     co.coarse_levels = options.coarse_levels - 1;
-    co.keep_near_vertices = false;  // only the agents' start matters
-    s.coarse_ = std::make_shared<const SurfaceBinding>(bind(g, features, co));
+    co.keep_near_vertices = false;  // only the agents' start matters,
+    co.max_reach_agents = std::min<std::size_t>(options.max_reach_agents, 4);  // so a rough blend will do
+    s.coarse_ = std::make_shared<const SurfaceBinding>(bind_level(g, features, co, &s));
     st.levels = 1 + s.coarse_->stats_.levels;
   }
   return s;

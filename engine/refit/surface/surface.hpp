@@ -30,7 +30,7 @@ struct SurfaceOptions {
   double reach_voxels = 3.0;       // a vertex is re-emitted from the agents within reach_voxels * h
   double ring_radius_voxels = 3.0; // one-ring candidates lie within this many voxels
   double block_voxels = 8.0;       // solver blocks are at least this many voxels wide (and wider than any one-ring edge)
-  std::size_t max_reach_agents = 64;  // cap on a vertex's agents (the nearest ones), for memory at large sizes
+  std::size_t max_reach_agents = 16;  // cap on a vertex's agents (the nearest ones), for memory at large sizes
   bool keep_near_vertices = true;  // garment vertices closer than epsilon to body B keep their warped positions too
   int coarse_levels = 4;           // coarse-to-fine start: solve first with voxels 2, 4, ... times larger (see apply)
   std::size_t coarse_min_agents = 500;   // no coarser level below this many agents
@@ -116,6 +116,11 @@ class SurfaceBinding {
   const SurfaceStats& bind_stats() const { return stats_; }
 
  private:
+  // One level of the coarse-to-fine hierarchy; `finer` (the level above) lends
+  // what does not depend on the voxel size.
+  static SurfaceBinding bind_level(const Garment& original, const Points& feature_samples,
+                                   const SurfaceOptions& options, const SurfaceBinding* finer);
+
   SurfaceOptions options_;
   double h_ = 0.0;
   std::size_t vertex_count_ = 0;
