@@ -1,0 +1,108 @@
+// The whole pipeline (warp, feature curves, surface, collision) on real MakeHuman
+// data: the dress and the skirt to every target body, and the two-layer outfit,
+// with the hem and four side profiles as features. Skips when ../shared/data is
+// absent. Asserts what holds today (every vertex written, no NaN, no more
+// vertices inside body B than the warp alone leaves) and prints the shape errors.
+#include "support/test_support.hpp"
+
+#include <refit/io/body_io.hpp>
+#include <refit/io/obj_garment.hpp>
+#include <refit/pipeline/resize.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <sstream>
+
+namespace refit {
+namespace {
+
+struct RealGarment {
+  const char* file;
+  double y_top, y_hem;  // the skirt part: profiles run from y_top down to the hem
+};
+
+std::string vec(const Vec3& p) {
+  std::ostringstream s;
+  s.precision(10);
+  s << "[" << p.x() << ", " << p.y() << ", " << p.z() << "]";
+  return s.str();
+}
+
+// Hem first (so each profile is held at both ends), then the left, right, front
+// and back profiles: the garment cut by the planes through body A's centre.
+std::string profile_features(const Garment& g, const BodyMesh& a, const RealGarment& rg) {
+  const double y_mid = 0.5 * (rg.y_top + rg.y_hem);
+  Vec3 centre = Vec3::Zero();
+  int count = 0;
+  for (Eigen::Index i = 0; i < a.vertices.rows(); ++i)
+    if (std::abs(a.vertices(i, 1) - y_mid) < 3.0) centre += a.vertices.row(i).transpose(), ++count;
+  centre /= count;
+  // The garment's outermost point at height y in the direction (dx, dz), on the cut plane.
+  // (Coarse garments have few vertices near any plane: take the farthest vertex
+  // in a band around it and put the point on the plane at that distance.)
+  const auto outer = [&](double y, double dx, double dz) {
+    double reach = 0.0;
+    for (Index i = 0; i < g.vertex_count(); ++i) {
+      const Vec3 p = row3(g.positions, i);
+      const double off_plane = dx != 0 ? p.z() - centre.z() : p.x() - centre.x();
+      if (std::abs(p.y() - y) > 2.0 || std::abs(off_plane) > 4.0) continue;
+      reach = std::max(reach, dx * (p.x() - centre.x()) + dz * (p.z() - centre.z()));
+    }
+    return Vec3(centre.x() + dx * reach, y, centre.z() + dz * reach);
+  };
+  std::string json = "{ \"units\": \"cm\", \"features\": [\n";
+  json += R"({ "name": "hem", "curve": { "kind": "boundary", "near": )" + vec(outer(rg.y_hem, 0, 1)) +
+          R"( }, "samples": 120 })";
+  struct Side {
+    const char* name;
+    double dx, dz;
+  };
+  for (const Side& s : {Side{"left", 1, 0}, Side{"right", -1, 0}, Side{"front", 0, 1}, Side{"back", 0, -1}}) {
+    const Vec3 normal = s.dx != 0 ? Vec3(0, 0, 1) : Vec3(1, 0, 0);
+    json += ",\n{ \"name\": \"" + std::string(s.name) + "\", \"plane\": { \"point\": " + vec(centre) +
+            ", \"normal\": " + vec(normal) + " }, \"curve\": { \"kind\": \"slice\", \"near\": " +
+            vec(outer(y_mid, s.dx, s.dz)) + ", \"control_points\": 12 }, \"samples\": 60 }";
+  }
+  return json + "\n] }\n";
+}
+
+void resize_to_targets(const RealGarment& rg, const std::vector<std::string>& targets) {
+  const std::string data = test::shared_data_dir();
+  if (data.empty()) GTEST_SKIP() << "../shared/data is absent: real-data pipeline test skipped";
+  auto garment = std::make_shared<const Garment>(read_garment_obj(data + "/garments/" + rg.file));
+  const BodyMesh a = read_body(data + "/bodies/A_female.obj");
+  ResizeOptions options;
+  options.metrics = true;
+  const GarmentBinding binding(garment, a, options, parse_feature_json(profile_features(*garment, a, rg), "features.json"));
+  for (const std::string& target : targets) {
+    SCOPED_TRACE(target);
+    const ResizeResult r = binding.resize(read_body(data + "/bodies/" + target + ".obj"));
+    ASSERT_EQ(r.positions.rows(), garment->positions.rows());
+    ASSERT_TRUE(r.positions.allFinite());
+    const auto& m = r.report.at("metrics");
+    const std::size_t inside_warp = m.at("warp").at("penetration").at("inside");
+    const std::size_t inside_result = m.at("result").at("penetration").at("inside");
+    std::printf("[ info ] %s -> %s: vertices inside body B: warp %zu, result %zu\n", rg.file, target.c_str(),
+                inside_warp, inside_result);
+    EXPECT_LE(inside_result, inside_warp);
+    for (const auto& f : r.report.at("features")) {
+      const double warped = f.at("shape_error_warped"), curve = f.at("shape_error_result"), output = f.at("shape_error_output");
+      std::printf("[ info ]   %-6s shape error: warp %.5f, optimised curve %.5f (%.0fx), written garment %.5f (%.1fx)\n",
+                  f.at("name").get<std::string>().c_str(), warped, curve, warped / std::max(curve, 1e-12), output,
+                  warped / std::max(output, 1e-12));
+      // Not asserted: on these coarse real garments (720 to 3091 vertices) the
+      // written garment does not yet keep the curves' shape better than the warp
+      // alone (issue 4 stays open; its note has these numbers).
+    }
+  }
+}
+
+const std::vector<std::string> kTargets = {"F_heavier", "F_thinner", "F_taller"};
+
+TEST(PipelineSharedData, DressToEveryTarget) { resize_to_targets({"dress_on_A_female.obj", 5.0, -29.9}, kTargets); }
+TEST(PipelineSharedData, SkirtToEveryTarget) { resize_to_targets({"skirt_on_A_female.obj", 10.0, -69.6}, kTargets); }
+TEST(PipelineSharedData, TwoLayerOutfit) { resize_to_targets({"outfit_dress_jeans_on_A_female.obj", 5.0, -29.9}, {"F_heavier"}); }
+
+}  // namespace
+}  // namespace refit
