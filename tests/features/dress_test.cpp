@@ -8,20 +8,11 @@
 
 #include <gtest/gtest.h>
 
+#include "curve_distance.hpp"
 #include "mannequin/mannequin.hpp"
 
 using namespace refit;
-
-namespace {
-
-double hausdorff(const Points& a, bool ca, const Points& b, bool cb) {
-  double h = 0;
-  for (Eigen::Index i = 0; i < a.rows(); ++i) h = std::max(h, nearest_on_polyline(b, cb, row3(a, static_cast<Index>(i))).distance);
-  for (Eigen::Index i = 0; i < b.rows(); ++i) h = std::max(h, nearest_on_polyline(a, ca, row3(b, static_cast<Index>(i))).distance);
-  return h;
-}
-
-}  // namespace
+using test::hausdorff;
 
 TEST(Dress, SlicesAndBoundariesAgreeOnTheDressAndItsSoup) {
   const mannequin::BodyParams body;

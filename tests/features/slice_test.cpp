@@ -5,12 +5,16 @@
 #include <refit/features/feature_curves.hpp>
 #include <refit/features/slice.hpp>
 
+#include "curve_distance.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
 
 using namespace refit;
+
+using test::hausdorff;
 
 namespace {
 
@@ -53,12 +57,6 @@ Garment soup_of(const Garment& g) {
   return s;
 }
 
-double hausdorff(const Points& a, bool ca, const Points& b, bool cb) {
-  double h = 0;
-  for (Eigen::Index i = 0; i < a.rows(); ++i) h = std::max(h, nearest_on_polyline(b, cb, row3(a, static_cast<Index>(i))).distance);
-  for (Eigen::Index i = 0; i < b.rows(); ++i) h = std::max(h, nearest_on_polyline(a, ca, row3(b, static_cast<Index>(i))).distance);
-  return h;
-}
 
 }  // namespace
 

@@ -123,11 +123,7 @@ PolylinePoint nearest_on_polyline(const Points& poly, bool closed, const Vec3& q
   const std::size_t edges = closed ? n : n - 1;
   double best2 = std::numeric_limits<double>::infinity();
   for (std::size_t e = 0; e < edges; ++e) {
-    const Vec3 a = row3(poly, static_cast<Index>(e)), b = row3(poly, static_cast<Index>((e + 1) % n));
-    const Vec3 d = b - a;
-    const double dd = d.squaredNorm();
-    const double t = dd > 0.0 ? std::clamp((q - a).dot(d) / dd, 0.0, 1.0) : 0.0;
-    const Vec3 p = a + t * d;
+    const auto [t, p] = closest_on_segment(q, row3(poly, static_cast<Index>(e)), row3(poly, static_cast<Index>((e + 1) % n)));
     const double d2 = (p - q).squaredNorm();
     if (d2 < best2) {
       best2 = d2;

@@ -3,6 +3,7 @@
 // arc-length resampling of polylines.
 #include <refit/core/types.hpp>
 
+#include <algorithm>
 #include <cstddef>
 
 namespace refit {
@@ -38,6 +39,18 @@ struct PolylinePoint {
   Vec3 point = Vec3::Zero();
   double param() const { return static_cast<double>(segment) + t; }
 };
+
+/// Closest point to q on the segment ab: parameter t in [0, 1] and the point.
+struct SegmentPoint {
+  double t = 0.0;
+  Vec3 point = Vec3::Zero();
+};
+inline SegmentPoint closest_on_segment(const Vec3& q, const Vec3& a, const Vec3& b) {
+  const Vec3 d = b - a;
+  const double dd = d.squaredNorm();
+  const double t = dd > 0.0 ? std::clamp((q - a).dot(d) / dd, 0.0, 1.0) : 0.0;
+  return {t, a + t * d};
+}
 
 /// Nearest point of a polyline (at least 1 row) to q; ties go to the first edge.
 PolylinePoint nearest_on_polyline(const Points& polyline, bool closed, const Vec3& q);

@@ -30,11 +30,7 @@ PolylinePoint nearest_near_vertex(const PointTree& tree, const Points& poly, boo
   PolylinePoint best;
   best.distance = std::numeric_limits<double>::infinity();
   auto try_edge = [&](std::size_t e) {
-    const Vec3 a = row3(poly, static_cast<Index>(e)), b = row3(poly, static_cast<Index>((e + 1) % m));
-    const Vec3 d = b - a;
-    const double dd = d.squaredNorm();
-    const double t = dd > 0.0 ? std::clamp((q - a).dot(d) / dd, 0.0, 1.0) : 0.0;
-    const Vec3 p = a + t * d;
+    const auto [t, p] = closest_on_segment(q, row3(poly, static_cast<Index>(e)), row3(poly, static_cast<Index>((e + 1) % m)));
     const double dist = (p - q).norm();
     if (dist < best.distance) best.distance = dist, best.segment = e, best.t = t, best.point = p;
   };
