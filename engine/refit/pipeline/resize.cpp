@@ -179,6 +179,10 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
     for (std::size_t i = 0; i < curves.curves.size(); ++i) {
       const CurveResult& c = curves.curves[i];
       list[i]["shape_error_output"] = shape_error(carry(feature_attachments_[i], result.positions), c.original, c.closed);
+      // The same measure on the warped garment: on a coarse mesh, carrying samples
+      // on its faces adds faceting that the free-point warp of the samples has not.
+      list[i]["shape_error_output_warped"] =
+          shape_error(carry(feature_attachments_[i], result.warped), c.original, c.closed);
     }
   }
   if (!result.positions.allFinite()) throw Error("internal: the surface step produced a non-finite position");
