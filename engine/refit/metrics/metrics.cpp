@@ -240,80 +240,113 @@ constexpr std::size_t kChunk = 1 << 16;
 
 }  // namespace
 
+namespace {
+
+// Closest point of p on a garment element of one (point), two (segment) or three
+// (triangle) corners, with barycentric weights of the corners.
+Candidate closest_on_element(const Vec3& p, const Points& x, const std::array<Index, 3>& v, int corners) {
+  Candidate c;
+  const Vec3 a = row3(x, v[0]);
+  if (corners == 1) {
+    c = {0.0, {v[0], v[0], v[0]}, {1.0, 0.0, 0.0}, a};
+  } else if (corners == 2) {
+    const Vec3 d = row3(x, v[1]) - a;
+    const double len2 = d.squaredNorm();
+    const double t = len2 > 0.0 ? std::clamp((p - a).dot(d) / len2, 0.0, 1.0) : 0.0;
+    c = {0.0, {v[0], v[1], v[1]}, {1.0 - t, t, 0.0}, a + t * d};
+  } else {
+    const Vec3 b = row3(x, v[1]), cc = row3(x, v[2]);
+    const Vec3 q = closest_point_on_triangle(p, a, b, cc);
+    const Vec3 v0 = b - a, v1 = cc - a, v2 = q - a;
+    const double d00 = v0.dot(v0), d01 = v0.dot(v1), d11 = v1.dot(v1), d20 = v2.dot(v0), d21 = v2.dot(v1);
+    const double den = d00 * d11 - d01 * d01;
+    const double wv = den != 0.0 ? (d11 * d20 - d01 * d21) / den : 0.0;
+    const double ww = den != 0.0 ? (d00 * d21 - d01 * d20) / den : 0.0;
+    c = {0.0, v, {1.0 - wv - ww, wv, ww}, q};
+  }
+  c.d2 = (c.point - p).squaredNorm();
+  return c;
+}
+
+// Every element of the garment once: fan triangles of the faces, segments of the
+// `l` polylines, the vertices of `p` elements.
+template <class Visit>
+void for_each_element(const Garment& g, std::size_t begin, std::size_t end, Visit&& visit) {
+  const std::size_t nf = g.faces.rows(), nl = g.lines.rows();
+  for (std::size_t e = begin; e < end; ++e) {
+    if (e < nf) {
+      const auto face = g.faces.row(e);
+      for (std::size_t k = 1; k + 1 < face.size(); ++k) visit(std::array<Index, 3>{face[0], face[k], face[k + 1]}, 3);
+    } else if (e < nf + nl) {
+      const auto line = g.lines.row(e - nf);
+      for (std::size_t k = 0; k + 1 < line.size(); ++k) visit(std::array<Index, 3>{line[k], line[k + 1], line[k + 1]}, 2);
+    } else {
+      for (Index v : g.points.row(e - nf - nl)) visit(std::array<Index, 3>{v, v, v}, 1);
+    }
+  }
+}
+
+}  // namespace
+
 SurfaceAttachment attach_points(const Garment& original, const Points& samples) {
-  const std::size_t nv = original.vertex_count(), n = static_cast<std::size_t>(samples.rows());
+  const std::size_t n = static_cast<std::size_t>(samples.rows());
+  const std::size_t ne = original.faces.rows() + original.lines.rows() + original.points.rows();
   SurfaceAttachment at;
   at.vertex.resize(n);
   at.weight.resize(n);
   at.offset.resize(samples.rows(), 3);
-  if (n == 0 || nv == 0) return at;
+  if (n == 0) return at;
+  if (ne == 0 && original.vertex_count() == 0) throw Error("attaching points: the garment has no vertices");
   const auto sample = [&](std::size_t s) { return Vec3(samples.row(static_cast<Eigen::Index>(s)).transpose()); };
+  const Points& x = original.positions;
 
-  // 1. Each sample's nearest vertex: every vertex asks the small tree of samples
-  // which one is nearest, and each sample keeps the nearest vertex that chose it.
-  // Linear in the garment, so attaching stays cheap at millions of vertices.
+  // 1. Each element offers its closest point to the samples within its bounding
+  // sphere grown by `slack`: linear in the garment, and exact for every sample
+  // whose closest element is nearer than `slack` (feature samples lie on the surface).
+  const Vec3 lo = samples.colwise().minCoeff().transpose(), hi = samples.colwise().maxCoeff().transpose();
+  const double slack = std::max(1e-9, 0.02 * (hi - lo).norm());
   const PointTree tree(samples);
-  const std::size_t vchunks = (nv + kChunk - 1) / kChunk;
-  std::vector<std::vector<Candidate>> per_chunk(vchunks, std::vector<Candidate>(n));
-  parallel_for(0, vchunks, 1, [&](std::size_t cb, std::size_t ce) {
+  const std::size_t chunks = (ne + kChunk - 1) / kChunk;
+  std::vector<std::vector<Candidate>> per_chunk(chunks, std::vector<Candidate>(n));
+  parallel_for(0, chunks, 1, [&](std::size_t cb, std::size_t ce) {
+    std::vector<std::pair<Index, double>> near;
     for (std::size_t c = cb; c < ce; ++c)
-      for (std::size_t v = c * kChunk; v < std::min(nv, (c + 1) * kChunk); ++v) {
-        const Vec3 p = row3(original.positions, static_cast<Index>(v));
-        const auto [s, d2] = tree.nearest(p);
-        Candidate& best = per_chunk[c][s];
-        if (d2 < best.d2) best = {d2, {Index(v), Index(v), Index(v)}, {1.0, 0.0, 0.0}, p};
-      }
+      for_each_element(original, c * kChunk, std::min(ne, (c + 1) * kChunk), [&](const std::array<Index, 3>& v, int corners) {
+        const Vec3 centre = (row3(x, v[0]) + row3(x, v[1]) + row3(x, v[2])) / 3.0;
+        double r = 0.0;
+        for (Index k : v) r = std::max(r, (row3(x, k) - centre).norm());
+        tree.within(centre, (r + slack) * (r + slack), near);
+        for (const auto& [s, d2] : near) {
+          const Candidate cand = closest_on_element(sample(std::size_t(s)), x, v, corners);
+          Candidate& best = per_chunk[c][std::size_t(s)];
+          if (cand.d2 < best.d2) best = cand;
+        }
+      });
   });
-  std::vector<Candidate> nearest = merge_chunks(per_chunk, n);
-  for (std::size_t s = 0; s < n; ++s) {
-    if (std::isfinite(nearest[s].d2)) continue;  // every vertex was nearer another sample
-    for (std::size_t v = 0; v < nv; ++v) {
-      const Vec3 p = row3(original.positions, static_cast<Index>(v));
-      const double d2 = (p - sample(s)).squaredNorm();
-      if (d2 < nearest[s].d2) nearest[s] = {d2, {Index(v), Index(v), Index(v)}, {1.0, 0.0, 0.0}, p};
-    }
-  }
+  std::vector<Candidate> best = merge_chunks(per_chunk, n);
 
-  // 2. The closest point on the (fan-triangulated) faces around that vertex.
-  std::vector<std::int64_t> first(nv, -1), next(n, -1);  // samples attached to each vertex, chained
-  for (std::size_t s = n; s-- > 0;) {
-    const Index v = nearest[s].vertex[0];
-    next[s] = first[v];
-    first[v] = static_cast<std::int64_t>(s);
-  }
-  const std::size_t nf = original.faces.rows(), fchunks = (nf + kChunk - 1) / kChunk;
-  per_chunk.assign(fchunks, std::vector<Candidate>(n));
-  parallel_for(0, fchunks, 1, [&](std::size_t cb, std::size_t ce) {
-    for (std::size_t c = cb; c < ce; ++c)
-      for (std::size_t f = c * kChunk; f < std::min(nf, (c + 1) * kChunk); ++f) {
-        const auto face = original.faces.row(f);
-        for (Index corner : face)
-          for (std::int64_t s = first[corner]; s >= 0; s = next[static_cast<std::size_t>(s)])
-            for (std::size_t k = 1; k + 1 < face.size(); ++k) {
-              const std::array<Index, 3> t{face[0], face[k], face[k + 1]};
-              const Vec3 a = row3(original.positions, t[0]), b = row3(original.positions, t[1]),
-                         cc = row3(original.positions, t[2]);
-              const Vec3 q = closest_point_on_triangle(sample(static_cast<std::size_t>(s)), a, b, cc);
-              const double d2 = (q - sample(static_cast<std::size_t>(s))).squaredNorm();
-              Candidate& best = per_chunk[c][static_cast<std::size_t>(s)];
-              if (!(d2 < best.d2)) continue;
-              // Barycentric coordinates of q in abc.
-              const Vec3 v0 = b - a, v1 = cc - a, v2 = q - a;
-              const double d00 = v0.dot(v0), d01 = v0.dot(v1), d11 = v1.dot(v1), d20 = v2.dot(v0), d21 = v2.dot(v1);
-              const double den = d00 * d11 - d01 * d01;
-              const double wv = den != 0.0 ? (d11 * d20 - d01 * d21) / den : 0.0;
-              const double ww = den != 0.0 ? (d00 * d21 - d01 * d20) / den : 0.0;
-              best = {d2, t, {1.0 - wv - ww, wv, ww}, q};
-            }
-      }
+  // 2. The rare sample farther than `slack` from every element: all elements (or,
+  // for a garment of bare vertices, all vertices).
+  parallel_for(0, n, 1, [&](std::size_t sb, std::size_t se) {
+    for (std::size_t s = sb; s < se; ++s) {
+      if (best[s].d2 <= slack * slack) continue;
+      const Vec3 p = sample(s);
+      for_each_element(original, 0, ne, [&](const std::array<Index, 3>& v, int corners) {
+        const Candidate cand = closest_on_element(p, x, v, corners);
+        if (cand.d2 < best[s].d2) best[s] = cand;
+      });
+      if (ne == 0)
+        for (Index v = 0; v < Index(original.vertex_count()); ++v) {
+          const Candidate cand = closest_on_element(p, x, {v, v, v}, 1);
+          if (cand.d2 < best[s].d2) best[s] = cand;
+        }
+    }
   });
-  const std::vector<Candidate> on_faces = merge_chunks(per_chunk, n);
   for (std::size_t s = 0; s < n; ++s) {
-    const Candidate& c = std::isfinite(on_faces[s].d2) ? on_faces[s] : nearest[s];  // no face: the vertex itself
-    at.vertex[s] = c.vertex;
-    at.weight[s] = c.weight;
+    at.vertex[s] = best[s].vertex;
+    at.weight[s] = best[s].weight;
     // Keep the sample's small offset from the surface as it was.
-    at.offset.row(static_cast<Eigen::Index>(s)) = (sample(s) - c.point).transpose();
+    at.offset.row(static_cast<Eigen::Index>(s)) = (sample(s) - best[s].point).transpose();
   }
   return at;
 }

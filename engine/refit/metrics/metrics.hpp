@@ -110,9 +110,9 @@ double profile_straightness(const Points& curve, const Points& original, bool cl
 /// straightness). Throws as profile_straightness.
 CurveScores score_curve(const Points& curve, const Points& original, bool closed);
 
-/// Where points sit on a garment: each point's closest point on the
-/// fan-triangulated faces (three vertices and barycentric weights) plus its small
-/// offset from there. A garment without faces uses each point's nearest vertex.
+/// Where points sit on a garment: each point's closest point on the garment's
+/// elements (fan-triangulated faces, `l` segments, `p` vertices) as three
+/// vertices and barycentric weights, plus its small offset from there.
 struct SurfaceAttachment {
   std::vector<std::array<Index, 3>> vertex;
   std::vector<std::array<double, 3>> weight;
