@@ -6,6 +6,7 @@
 // order (Refit's or another tool's).
 #include <refit/body/body_mesh.hpp>
 #include <refit/body/body_surface.hpp>
+#include <refit/attach/attachment.hpp>
 #include <refit/core/garment.hpp>
 #include <refit/features/feature_file.hpp>
 
@@ -109,24 +110,6 @@ double profile_straightness(const Points& curve, const Points& original, bool cl
 /// Scores of one curve against its original (shape error, turning angle,
 /// straightness). Throws as profile_straightness.
 CurveScores score_curve(const Points& curve, const Points& original, bool closed);
-
-/// Where points sit on a garment: each point's closest point on the garment's
-/// elements (fan-triangulated faces, `l` segments, `p` vertices) as three
-/// vertices and barycentric weights, plus its small offset from there.
-struct SurfaceAttachment {
-  std::vector<std::array<Index, 3>> vertex;
-  std::vector<std::array<double, 3>> weight;
-  Points offset;
-};
-
-/// Attaches `samples` to the original garment (bind once).
-SurfaceAttachment attach_points(const Garment& original, const Points& samples);
-
-/// The attached points on another state of the garment (same vertex order).
-Points carry(const SurfaceAttachment& attachment, const Points& result);
-
-/// attach_points then carry: the same material points on the result.
-Points carry_points(const Garment& original, const Points& result, const Points& samples);
 
 /// Feature curves of `specs` on the original (features module), the warp alone
 /// of their samples from body a to body b (step 1), and the same material

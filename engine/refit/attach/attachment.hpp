@@ -1,0 +1,32 @@
+#pragma once
+// Points bound to a garment's surface: where a curve sample sits on the original
+// garment, so that the same material point can be found on any deformed state.
+#include <refit/core/garment.hpp>
+
+#include <array>
+#include <vector>
+
+namespace refit {
+
+/// Where points sit on a garment: each point's closest point on the garment's
+/// elements (fan-triangulated faces, `l` segments, `p` vertices) as three
+/// vertices and barycentric weights, plus its small offset from there.
+struct SurfaceAttachment {
+  std::vector<std::array<Index, 3>> vertex;
+  std::vector<std::array<double, 3>> weight;
+  Points offset;
+};
+
+/// Attaches `samples` to the original garment (bind once).
+SurfaceAttachment attach_points(const Garment& original, const Points& samples);
+
+/// The attached points on another state of the garment (same vertex order).
+Points carry(const SurfaceAttachment& attachment, const Points& result);
+
+/// Attached point `i` on another state of the garment.
+Vec3 carry_one(const SurfaceAttachment& attachment, const Points& result, Index i);
+
+/// attach_points then carry: the same material points on the result.
+Points carry_points(const Garment& original, const Points& result, const Points& samples);
+
+}  // namespace refit
