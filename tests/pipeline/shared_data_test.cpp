@@ -2,7 +2,8 @@
 // data: the dress and the skirt to every target body, and the two-layer outfit,
 // with the hem and four side profiles as features. Skips when ../shared/data is
 // absent. Asserts what holds today (every vertex written, no NaN, no more
-// vertices inside body B than the warp alone leaves) and prints the shape errors.
+// vertices inside body B than the warp alone leaves, the written garment keeps
+// the curves no worse than the warp) and prints the shape errors.
 #include "support/test_support.hpp"
 
 #include <refit/io/body_io.hpp>
@@ -11,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -20,6 +22,11 @@ namespace {
 struct RealGarment {
   const char* file;
   double y_top, y_hem;  // the skirt part: profiles run from y_top down to the hem
+  double y_back_end;    // where the back profile ends (the dress has a back slit from y = -12.2 cm down)
+  // The dress's hem boundary loop runs up both sides of the slit: no plane holds
+  // it, and step 2 flattens it into one (the slit's edges sag into a V). Its hem
+  // is then the slice 1 cm above the hem edge instead (an open curve).
+  bool hem_as_slice;
 };
 
 std::string vec(const Vec3& p) {
@@ -30,14 +37,22 @@ std::string vec(const Vec3& p) {
 }
 
 // Hem first (so each profile is held at both ends), then the left, right, front
-// and back profiles: the garment cut by the planes through body A's centre.
+// and back profiles: the garment cut by the planes through body A's centre (mean
+// vertex of its skirt part): z = centre z (normal +Z) gives the left and right pieces, x = centre x
+// (normal +X) the front and back pieces, each clipped between the waist and the
+// hem levels of the garment's skirt part.
 std::string profile_features(const Garment& g, const BodyMesh& a, const RealGarment& rg) {
   const double y_mid = 0.5 * (rg.y_top + rg.y_hem);
-  Vec3 centre = Vec3::Zero();
-  int count = 0;
+  // Body A's centre: the middle of its bounding box at the waist level (|x| < 18 cm:
+  // the torso, not the arms). The mean vertex is pulled forward by MakeHuman's
+  // dense face, hands and feet (12 cm for the whole body), off the skirt's middle.
+  Vec3 lo = Vec3::Constant(1e30), hi = -lo;
   for (Eigen::Index i = 0; i < a.vertices.rows(); ++i)
-    if (std::abs(a.vertices(i, 1) - y_mid) < 3.0) centre += a.vertices.row(i).transpose(), ++count;
-  centre /= count;
+    if (std::abs(a.vertices(i, 1) - rg.y_top) < 2.0 && std::abs(a.vertices(i, 0)) < 18.0) {
+      lo = lo.cwiseMin(a.vertices.row(i).transpose());
+      hi = hi.cwiseMax(a.vertices.row(i).transpose());
+    }
+  const Vec3 centre = 0.5 * (lo + hi);
   // The garment's outermost point at height y in the direction (dx, dz), on the cut plane.
   // (Coarse garments have few vertices near any plane: take the farthest vertex
   // in a band around it and put the point on the plane at that distance.)
@@ -52,8 +67,13 @@ std::string profile_features(const Garment& g, const BodyMesh& a, const RealGarm
     return Vec3(centre.x() + dx * reach, y, centre.z() + dz * reach);
   };
   std::string json = "{ \"units\": \"cm\", \"features\": [\n";
-  json += R"({ "name": "hem", "curve": { "kind": "boundary", "near": )" + vec(outer(rg.y_hem, 0, 1)) +
-          R"( }, "samples": 120 })";
+  if (rg.hem_as_slice)
+    json += R"({ "name": "hem", "plane": { "point": )" + vec(Vec3(centre.x(), rg.y_hem + 1.0, centre.z())) +
+            R"(, "normal": [0, 1, 0] }, "curve": { "kind": "slice", "near": )" + vec(outer(rg.y_hem + 1.0, 0, 1)) +
+            R"(, "control_points": 24 }, "samples": 120 })";
+  else
+    json += R"({ "name": "hem", "curve": { "kind": "boundary", "near": )" + vec(outer(rg.y_hem, 0, 1)) +
+            R"( }, "samples": 120 })";
   struct Side {
     const char* name;
     double dx, dz;
@@ -62,7 +82,8 @@ std::string profile_features(const Garment& g, const BodyMesh& a, const RealGarm
     const Vec3 normal = s.dx != 0 ? Vec3(0, 0, 1) : Vec3(1, 0, 0);
     json += ",\n{ \"name\": \"" + std::string(s.name) + "\", \"plane\": { \"point\": " + vec(centre) +
             ", \"normal\": " + vec(normal) + " }, \"curve\": { \"kind\": \"slice\", \"near\": " +
-            vec(outer(y_mid, s.dx, s.dz)) + ", \"control_points\": 12 }, \"samples\": 60 }";
+            vec(outer(y_mid, s.dx, s.dz)) + ", \"from\": " + vec(outer(rg.y_top, s.dx, s.dz)) +
+            ", \"to\": " + vec(outer(s.dz < 0 ? rg.y_back_end : rg.y_hem, s.dx, s.dz)) + ", \"control_points\": 12 }, \"samples\": 60 }";
   }
   return json + "\n] }\n";
 }
@@ -86,25 +107,31 @@ void resize_to_targets(const RealGarment& rg, const std::vector<std::string>& ta
     std::printf("[ info ] %s -> %s: vertices inside body B: warp %zu, result %zu\n", rg.file, target.c_str(),
                 inside_warp, inside_result);
     EXPECT_LE(inside_result, inside_warp);
+    double sum_output_warped = 0.0, sum_output = 0.0;
     for (const auto& f : r.report.at("features")) {
       const double warped = f.at("shape_error_warped"), curve = f.at("shape_error_result"), output = f.at("shape_error_output");
       const double output_warped = f.at("shape_error_output_warped");
-      std::printf("[ info ]   %-6s shape error: warp %.5f, optimised curve %.5f (%.0fx); on the garment: warp %.5f, "
-                  "result %.5f (%.1fx)\n",
-                  f.at("name").get<std::string>().c_str(), warped, curve, warped / std::max(curve, 1e-12), output_warped,
-                  output, output_warped / std::max(output, 1e-12));
-      // Not asserted: on these coarse real garments (720 to 3091 vertices) the
-      // written garment does not yet keep the curves' shape better than the warp
-      // alone (issue 4 stays open; its note has these numbers).
+      ASSERT_TRUE(std::isfinite(output));
+      sum_output_warped += output_warped;
+      sum_output += output;
+      std::printf("[ info ]   %-6s shape error: warp %.5f, optimised curve %.5f (%.0fx), written garment %.5f (%.1fx); "
+                  "carried on the warped garment %.5f (%.1fx)\n",
+                  f.at("name").get<std::string>().c_str(), warped, curve, warped / std::max(curve, 1e-12), output,
+                  warped / std::max(output, 1e-12), output_warped, output_warped / std::max(output, 1e-12));
     }
+    // What holds today on these coarse garments (720 to 3091 vertices): the
+    // written garment keeps the feature curves at least as well as the warp alone,
+    // measured alike (samples carried on the garment), within 5% over all
+    // features: 0.99x-1.5x, far from the issue's 10x (see the surface report).
+    EXPECT_LT(sum_output, 1.05 * sum_output_warped);
   }
 }
 
 const std::vector<std::string> kTargets = {"F_heavier", "F_thinner", "F_taller"};
 
-TEST(PipelineSharedData, DressToEveryTarget) { resize_to_targets({"dress_on_A_female.obj", 5.0, -29.9}, kTargets); }
-TEST(PipelineSharedData, SkirtToEveryTarget) { resize_to_targets({"skirt_on_A_female.obj", 10.0, -69.6}, kTargets); }
-TEST(PipelineSharedData, TwoLayerOutfit) { resize_to_targets({"outfit_dress_jeans_on_A_female.obj", 5.0, -29.9}, {"F_heavier"}); }
+TEST(PipelineSharedData, DressToEveryTarget) { resize_to_targets({"dress_on_A_female.obj", 5.0, -29.9, -11.5, true}, kTargets); }
+TEST(PipelineSharedData, SkirtToEveryTarget) { resize_to_targets({"skirt_on_A_female.obj", 10.0, -69.6, -69.6, false}, kTargets); }
+TEST(PipelineSharedData, TwoLayerOutfit) { resize_to_targets({"outfit_dress_jeans_on_A_female.obj", 5.0, -29.9, -11.5, true}, {"F_heavier"}); }
 
 }  // namespace
 }  // namespace refit

@@ -1,6 +1,7 @@
 // End to end on the procedural dress: warp (step 1), feature curves (step 2),
 // then the surface (step 3) to a body with a belly bump.
 #include <refit/body/body_surface.hpp>
+#include <refit/core/parallel.hpp>
 #include <refit/features/curve_metrics.hpp>
 #include <refit/features/feature_curves.hpp>
 #include <refit/features/feature_file.hpp>
@@ -16,6 +17,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <string>
 #include <map>
 #include <numbers>
 
@@ -33,11 +36,13 @@ struct Case {
   std::vector<double> body_distance;  // of each warped vertex to body B
 };
 
-Case run_dress(bool soup, std::size_t target_vertices = 6000, SurfaceOptions so = {}) {
+Case run_dress(bool soup, std::size_t target_vertices = 6000, SurfaceOptions so = {}, bool same_body = false) {
   const mq::BodyParams a{};
   mq::BodyParams b = a;
-  b.belly = 8;
-  b.hip = a.hip + 6;
+  if (!same_body) {
+    b.belly = 8;
+    b.hip = a.hip + 6;
+  }
   mq::GarmentParams gp;
   gp.kind = mq::GarmentParams::Kind::Dress;
   gp.target_vertices = target_vertices;
@@ -158,10 +163,11 @@ TEST(SurfaceDress, FollowsTheProfilesAndKeepsTheBodyContact) {
     std::printf("  slice at %.0f deg (%zu vertices): shape error warp %.5f result %.5f (gain %.1f)\n",
                 phi * 180 / std::numbers::pi, idx.size(), e_warp, e_res, e_warp / e_res);
     const bool feature = std::abs(std::sin(phi)) < 1e-9;
-    // The targets are 10x on the profiles and 3x between them; measured on
-    // vertices within 0.4 cm of the plane we reach about 6x and 2.1-3.8x (see the
-    // module's report), so this guards what is reached.
-    EXPECT_LT(e_res * (feature ? 5.0 : 2.0), e_warp) << "slice at " << phi;
+    // The targets: 10x on the profiles, 3x on a held-out slice between
+    // them. Measured (vertices within 0.4 cm of the plane): 62x and 110x on the
+    // profiles, 4.6x and 3.6x between them (the paper's frames and blend: 8x,
+    // 7x, 3.3x, 2.7x).
+    EXPECT_LT(e_res * (feature ? 10.0 : 3.0), e_warp) << "slice at " << phi;
   }
   // The feature curves themselves (step 2's own numbers, for the record).
   for (const auto& cr : c.curves)
@@ -193,11 +199,58 @@ TEST(SurfaceDress, ManifoldAndSoupAgree) {
   std::printf("soup vs manifold: %zu matched vertices, mean difference %.4f cm, max %.4f cm; mean step-3 move %.4f cm\n",
               matched, sum / double(matched), worst, moved / double(matched));
   EXPECT_GT(matched, m.dress.vertex_count() * 9 / 10);
-  // Measured: mean 0.16 cm, max 1.5 cm for a mean step-3 correction of the
-  // order of a centimetre; the agents differ near the soup's extras (flap,
-  // drawstrings, buttons) and where the duplicated seams change the samples.
-  EXPECT_LT(sum, 0.4 * moved);
-  EXPECT_LT(worst, 2.0);
+  // Measured: mean 0.14 cm, max 1.28 cm for a mean step-3 move of 0.58 cm (24%);
+  // the agents differ near the soup's extras (flap, drawstrings, buttons) and
+  // where the duplicated seams change the samples.
+  EXPECT_LT(sum, 0.3 * moved);
+  EXPECT_LT(worst, 1.5);
+}
+
+// The profile shape error (vertices within 0.4 cm of the plane at phi) of a result.
+double profile_error(const Case& c, const Points& result, double phi) {
+  const auto idx = half_plane_vertices(c, phi, 0.4);
+  return shape_error(rows_of(result, idx), rows_of(c.dress.positions, idx), false);
+}
+
+TEST(SurfaceDress, DocumentedImprovementsBeatThePapersFramesAndBlend) {
+  // The paper's way: fan frames, eq. 4 blend, vertices re-emitted from their
+  // warped offsets. Ours: least-squares ring rotations, smooth kernel, original
+  // offsets, smoothed displacements (surface.hpp). Measured: profile errors 8x
+  // and 7x below the warp the paper's way, 62x and 110x ours.
+  SurfaceOptions paper;
+  paper.fit_rotations = false;
+  paper.smooth_blend = false;
+  paper.emit_from_original = false;
+  paper.smooth_passes = 0;
+  const Case p = run_dress(false, 6000, paper);
+  const Case o = run_dress(false, 6000);
+  ASSERT_TRUE(p.result.allFinite());
+  for (const double phi : {0.0, std::numbers::pi}) {
+    const double e_paper = profile_error(p, p.result, phi), e_ours = profile_error(o, o.result, phi);
+    std::printf("  profile at %.0f deg: shape error paper's way %.5f, ours %.5f\n", phi * 180 / std::numbers::pi, e_paper,
+                e_ours);
+    EXPECT_LT(e_ours, 0.5 * e_paper) << phi;
+  }
+}
+
+TEST(SurfaceDress, SameBodyGivesTheInputBackAndThreadsDoNotMatter) {
+  // A = B and the features at their original places: the output is the input.
+  const Case same = run_dress(false, 6000, {}, true);
+  const double scale = same.dress.positions.cwiseAbs().maxCoeff();
+  EXPECT_LT((same.result - same.dress.positions).cwiseAbs().maxCoeff(), 1e-6 * scale);
+  // 1 and 2 threads, coarse levels and all: the same bytes.
+  Case one, two;
+  {
+    const ThreadLimit limit(1);
+    one = run_dress(false);
+  }
+  {
+    const ThreadLimit limit(2);
+    two = run_dress(false);
+  }
+  EXPECT_GE(one.stats.levels, 2);
+  ASSERT_EQ(one.result.rows(), two.result.rows());
+  EXPECT_EQ(std::memcmp(one.result.data(), two.result.data(), sizeof(double) * one.result.size()), 0);
 }
 
 }  // namespace

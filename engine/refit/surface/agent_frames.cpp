@@ -2,6 +2,7 @@
 #include <refit/surface/agent_frames.hpp>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
@@ -191,6 +192,80 @@ Points reconstruct(const Points& v, const AgentFrames& before, const AgentFrames
           const double len = local.norm();
           const double w = 1.0 / (1e-8 + len * len * len);  // eq. 4
           sum += w * emitted;
+          wsum += w;
+        }
+        q = sum / wsum;
+      }
+      out.row(static_cast<Eigen::Index>(i)) = q.transpose();
+    }
+  });
+  return out;
+}
+
+std::vector<Eigen::Matrix3d> ring_rotations(const Points& from, const Points& to, const Csr& ring) {
+  const std::size_t n = ring.rows();
+  std::vector<Eigen::Matrix3d> out(n, Eigen::Matrix3d::Identity());
+  parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t a = b; a < e; ++a) {
+      auto r = ring.row(a);
+      if (r.size() < 2) continue;
+      const Vec3 pf = row3(from, Index(a)), pt = row3(to, Index(a));
+      Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+      double scale = 0.0;
+      for (Index q : r) {
+        const Vec3 df = row3(from, q) - pf, dt = row3(to, q) - pt;
+        // Edges weighted by 1/|edge|^2: every direction counts alike (a long edge is no surer).
+        const double w = 1.0 / std::max(df.squaredNorm(), 1e-300);
+        cov += w * dt * df.transpose();
+        scale += w * df.squaredNorm();
+      }
+      Eigen::JacobiSVD<Eigen::Matrix3d> svd(cov, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      const Vec3 sv = svd.singularValues();
+      if (!(sv[1] > 1e-9 * scale)) continue;  // collinear ring: the rotation about the line is unknown
+      Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+      if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0) d(2, 2) = -1.0;
+      out[a] = svd.matrixU() * d * svd.matrixV().transpose();
+    }
+  });
+  return out;
+}
+
+std::vector<Eigen::Matrix3d> frame_rotations(const AgentFrames& before, const AgentFrames& after) {
+  const std::size_t n = before.axes.size();
+  std::vector<Eigen::Matrix3d> out(n, Eigen::Matrix3d::Identity());
+  for (std::size_t a = 0; a < n; ++a)
+    if (before.valid[a] && after.valid[a]) out[a] = after.axes[a] * before.axes[a].transpose();
+  return out;
+}
+
+Points reconstruct_rotations(const Points& v, const Points& before, const Points& after,
+                             const std::vector<Eigen::Matrix3d>& rotation, const Csr& reach,
+                             const std::vector<float>& weights, const std::vector<Index>& nearest,
+                             const std::vector<std::uint8_t>& keep, const Points* kept) {
+  const std::size_t n = static_cast<std::size_t>(v.rows());
+  Points out(v.rows(), 3);
+  parallel_for(0, n, 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      const Vec3 p = row3(v, Index(i));
+      auto r = reach.row(i);
+      Vec3 q;
+      if (r.empty()) {
+        const Index j = nearest[i];
+        q = !keep.empty() && keep[j] ? row3(*kept, Index(i)) : Vec3(p + row3(after, j) - row3(before, j));
+      } else {
+        Vec3 sum = Vec3::Zero();
+        double wsum = 0.0;
+        for (std::size_t k = 0; k < r.size(); ++k) {
+          const Index j = r[k];
+          const Vec3 d = p - row3(before, j);
+          double w;
+          if (weights.empty()) {
+            const double len = d.norm();
+            w = 1.0 / (1e-8 + len * len * len);  // eq. 4
+          } else {
+            w = weights[reach.offsets[i] + k];
+          }
+          sum += w * (!keep.empty() && keep[j] ? row3(*kept, Index(i)) : Vec3(row3(after, j) + rotation[j] * d));
           wsum += w;
         }
         q = sum / wsum;

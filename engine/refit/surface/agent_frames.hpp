@@ -46,4 +46,30 @@ AgentFrames agent_frames(const Points& x, const Csr& ring, const std::vector<std
 Points reconstruct(const Points& vertices, const AgentFrames& before, const AgentFrames& after, const Csr& reach,
                    const std::vector<Index>& nearest);
 
+/// Per agent the rotation that best carries its one-ring from `from` to `to`
+/// (least squares over the ring edges a_i - a, Kabsch: SVD of the 3x3 covariance,
+/// determinant fixed to +1). An improvement over the paper's fan frames (section
+/// 5.3): the fan normal and the single-neighbour tangent of an irregular agent
+/// ring are noisy, and their noise times the distance to a vertex shows as
+/// texture; the fit uses every neighbour. Identity where the ring has fewer than
+/// two non-collinear edges. Exactly the identity (to rounding) when from == to.
+std::vector<Eigen::Matrix3d> ring_rotations(const Points& from, const Points& to, const Csr& ring);
+
+/// Rotation from `before` to `after` frames per agent (after.axes * before.axes^T;
+/// identity where either frame is invalid): the paper's fan frames as rotations.
+std::vector<Eigen::Matrix3d> frame_rotations(const AgentFrames& before, const AgentFrames& after);
+
+/// Re-emits every vertex (rows of `vertices`, on the `before` state) from the
+/// agents reach.row(v): q = sum_j w_j (after_j + R_j (p - before_j)) / sum_j w_j.
+/// With `weights` (parallel to reach.indices) those weights are used; with an
+/// empty `weights` the eq.-4 weights w = 1/(1e-8 + |p - before_j|^3) (|local| of
+/// eq. 4: a rotation keeps the length). A vertex with an empty list moves with
+/// agent nearest[v] (translation only). An agent with keep[j] != 0 (keep non-empty)
+/// contributes the vertex's row of `kept` instead (an agent that did not move).
+/// Deterministic, parallel.
+Points reconstruct_rotations(const Points& vertices, const Points& before, const Points& after,
+                             const std::vector<Eigen::Matrix3d>& rotation, const Csr& reach,
+                             const std::vector<float>& weights, const std::vector<Index>& nearest,
+                             const std::vector<std::uint8_t>& keep = {}, const Points* kept = nullptr);
+
 }  // namespace refit

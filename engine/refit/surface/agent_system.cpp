@@ -1,3 +1,4 @@
+#include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
 #include <refit/surface/agent_system.hpp>
 #include <refit/surface/agents.hpp>
@@ -174,15 +175,21 @@ bool BlockSchedule::concurrent(Index a, Index b) const {
 
 SolveReport gauss_seidel(const AgentRows& rows, const BlockSchedule& s, const std::vector<std::uint8_t>& free,
                          Points& x, const SolveOptions& options) {
+  return gauss_seidel(rows, rows.h, s, free, x, options);
+}
+
+SolveReport gauss_seidel(const AgentRows& rows, const Points& hvec, const BlockSchedule& s,
+                         const std::vector<std::uint8_t>& free, Points& x, const SolveOptions& options) {
   // The sweep works on x, y, z interleaved (3 x n, column-major): one neighbour
   // read is one cache line instead of three.
   Eigen::Matrix<double, 3, Eigen::Dynamic> p = x.transpose();
   const Index* idx = rows.ring.indices.data();
   const Index* off = rows.ring.offsets.data();
   const double* w = rows.weight.data();
+  const double omega = options.relaxation;
   auto update = [&](std::size_t a) -> double {
     if (!free[a] || !(rows.diag[a] > 0.0)) return 0.0;
-    double sx = rows.h(Eigen::Index(a), 0), sy = rows.h(Eigen::Index(a), 1), sz = rows.h(Eigen::Index(a), 2);
+    double sx = hvec(Eigen::Index(a), 0), sy = hvec(Eigen::Index(a), 1), sz = hvec(Eigen::Index(a), 2);
     for (Index k = off[a]; k < off[a + 1]; ++k) {
       const double* q = p.data() + 3 * std::size_t(idx[k]);
       sx += w[k] * q[0];
@@ -191,7 +198,7 @@ SolveReport gauss_seidel(const AgentRows& rows, const BlockSchedule& s, const st
     }
     const double inv = 1.0 / rows.diag[a];
     double* q = p.data() + 3 * a;
-    const double dx = sx * inv - q[0], dy = sy * inv - q[1], dz = sz * inv - q[2];
+    const double dx = omega * (sx * inv - q[0]), dy = omega * (sy * inv - q[1]), dz = omega * (sz * inv - q[2]);
     q[0] += dx;
     q[1] += dy;
     q[2] += dz;
@@ -217,6 +224,11 @@ SolveReport gauss_seidel(const AgentRows& rows, const BlockSchedule& s, const st
     for (Index a : s.sequential_agents) total += update(a);
     report.iterations = it + 1;
     report.final_update = std::sqrt(total);
+    // Plain Gauss-Seidel cannot diverge on these weakly diagonally dominant rows;
+    // over-relaxation can (the matrix is not symmetric): never hand back NaN.
+    if (!std::isfinite(report.final_update))
+      throw Error("surface: the Gauss-Seidel sweeps diverged at iteration " + std::to_string(it + 1) +
+                  " (over-relaxation factor " + std::to_string(omega) + " is too large for this system)");
     if (report.final_update < options.tolerance) {
       report.converged = true;
       break;

@@ -69,6 +69,7 @@ double longest_edge(const Points& positions, const Csr& ring);
 struct SolveOptions {
   int max_iterations = 500;
   double tolerance = 1e-5;  // on the L2 norm of one iteration's update over all free agents
+  double relaxation = 1.0;  // successive over-relaxation factor (1 = plain Gauss-Seidel)
 };
 struct SolveReport {
   int iterations = 0;
@@ -77,8 +78,14 @@ struct SolveReport {
 };
 
 /// Gauss-Seidel on eq. 13 from x (n x 3, updated in place); agents with free[a] == 0
-/// keep their x. Deterministic: bit-identical for any thread count.
+/// keep their x. Deterministic: bit-identical for any thread count. Throws
+/// refit::Error when the update norm stops being finite (only over-relaxation,
+/// relaxation > 1, can make the sweeps diverge).
 SolveReport gauss_seidel(const AgentRows& rows, const BlockSchedule& schedule, const std::vector<std::uint8_t>& free,
                          Points& x, const SolveOptions& options);
+/// The same with the compensation vectors `h` (n x 3) in place of rows.h (for
+/// example rows.h turned with each agent's local rotation).
+SolveReport gauss_seidel(const AgentRows& rows, const Points& h, const BlockSchedule& schedule,
+                         const std::vector<std::uint8_t>& free, Points& x, const SolveOptions& options);
 
 }  // namespace refit

@@ -9,6 +9,7 @@
 // normal orientation, and each vertex's agents within reach. Apply many
 // (SurfaceBinding::apply, per body B): the constraints (eqs. 14-15), the
 // Gauss-Seidel solve of eq. 13 and the reconstruction (eq. 4 blending).
+#include <refit/attach/attachment.hpp>
 #include <refit/core/garment.hpp>
 #include <refit/surface/agent_frames.hpp>
 #include <refit/surface/agent_system.hpp>
@@ -26,14 +27,24 @@ struct SurfaceOptions {
   double epsilon = 1.0;            // an agent closer than this to body B keeps its warped position (eq. 14)
   int max_iterations = 500;        // Gauss-Seidel iterations, at most
   double tolerance = 1e-5;         // stop when an iteration's update has an L2 norm below this
+  double relaxation = 1.0;         // over-relaxation factor of the sweeps (1 = the paper's Gauss-Seidel). Measured on the
+                                   // 6k dress: 1.5 converges 2.8x faster, 1.6 diverges (eq. 13 is not symmetric): kept at 1
   bool encode_on_warped = false;   // encode eqs. 10-12 on the warped agents instead of the original ones
   double reach_voxels = 3.0;       // a vertex is re-emitted from the agents within reach_voxels * h
   double ring_radius_voxels = 3.0; // one-ring candidates lie within this many voxels
   double block_voxels = 8.0;       // solver blocks are at least this many voxels wide (and wider than any one-ring edge)
-  std::size_t max_reach_agents = 16;  // cap on a vertex's agents (the nearest ones), for memory at large sizes
+  std::size_t max_reach_agents = 8;   // a vertex blends its nearest agents (at most this many, within reach)
   bool keep_near_vertices = true;  // garment vertices closer than epsilon to body B keep their warped positions too
-  int coarse_levels = 4;           // coarse-to-fine start: solve first with voxels 2, 4, ... times larger (see apply)
+  int coarse_levels = 4;           // coarse-to-fine start: agent subsets with voxels 2, 4, ... times larger (see apply)
   std::size_t coarse_min_agents = 500;   // no coarser level below this many agents
+  // Beyond the paper (each documented where it is used; false gives the paper's way):
+  bool rotate_encoding = false;    // turn each h (eq. 12) with the agent's ring rotation from the original to the warp (measured worse: see apply)
+  bool fit_rotations = true;       // frames as least-squares ring rotations instead of fan normal + one-neighbour tangent
+  bool smooth_blend = true;        // vertex blend with a smooth compact kernel bound on the original instead of eq. 4
+  int smooth_passes = 5;           // passes of one-ring averaging of the free agents' displacements after the solve
+                                   // (0 = the paper's solution as is; see apply)
+  bool emit_from_original = true;  // re-emit each vertex from its ORIGINAL offsets to the agents (original -> optimised
+                                   // rotations) instead of its warped ones: the warp's creases finer than h go away
 };
 
 struct SurfaceTimings {
@@ -78,11 +89,12 @@ class SurfaceBinding {
   /// positions or bad indices.
   static SurfaceBinding bind(const Garment& original, const Points& feature_samples, const SurfaceOptions& options = {});
 
-  /// With coarse levels, the free agents start from the result of the next
-  /// coarser binding (voxel 2h) instead of their warped positions: Gauss-Seidel
-  /// removes smooth errors slowly (iterations grow with the squared agent count
-  /// across the garment), so a coarse start is what makes 500 iterations enough.
-  /// The fixed point (eq. 13 with eqs. 14-15) is the same.
+  /// With coarse levels, the free agents start from the solution on the next
+  /// coarser agent subset (voxel 2h), interpolated: Gauss-Seidel removes smooth
+  /// errors slowly (iterations grow with the squared agent count across the
+  /// garment), so a coarse start saves most of them. The fixed point (eq. 13
+  /// with eqs. 14-15) is the same. With rotate_encoding, each h is turned by the
+  /// rotation that best carries the agent's original ring onto its warped ring.
   ///
   /// Deforms the warped garment so that feature agents reach `feature_targets`
   /// (same rows as the bound feature samples, eq. 15), agents closer than epsilon to
@@ -116,10 +128,18 @@ class SurfaceBinding {
   const SurfaceStats& bind_stats() const { return stats_; }
 
  private:
-  // One level of the coarse-to-fine hierarchy; `finer` (the level above) lends
-  // what does not depend on the voxel size.
-  static SurfaceBinding bind_level(const Garment& original, const Points& feature_samples,
-                                   const SurfaceOptions& options, const SurfaceBinding* finer);
+  // A coarser level of the coarse-to-fine start: a subset of the agents (every
+  // feature agent, and per voxel of the coarser grid the agent nearest its
+  // centre) with its own one-rings, encoding and schedule.
+  struct Level {
+    std::vector<Index> agent;      // fine storage slot of each agent of the level (level storage order)
+    Csr ring;
+    AgentRows rows;
+    BlockSchedule schedule;
+    std::vector<Index> group;      // connected group (one-ring graph of the level)
+    Csr up;                        // per agent of the next finer level: the level's agents it interpolates from
+    std::vector<float> up_weight;  // parallel to up.indices
+  };
 
   SurfaceOptions options_;
   double h_ = 0.0;
@@ -129,8 +149,7 @@ class SurfaceBinding {
   std::vector<std::array<double, 3>> src_weight_;
   std::vector<std::int32_t> feature_of_;
   std::vector<Index> feature_slot_;
-  Points feature_offset_;            // feature sample - its nearest original vertex
-  std::vector<Index> feature_vertex_;  // that vertex
+  SurfaceAttachment feature_attachment_;  // where each feature sample sits on the original garment
   Points original_agents_;
   Csr ring_;                         // angular order (see order_rings)
   std::vector<std::uint8_t> ring_open_;
@@ -139,10 +158,12 @@ class SurfaceBinding {
   BlockSchedule schedule_;
   std::vector<Index> group_;         // connected group of each agent (one-ring graph)
   std::size_t groups_ = 0;
-  Csr reach_;                        // per garment vertex: agents within reach
+  Csr reach_;                        // per garment vertex: its nearest agents within reach
+  std::vector<float> reach_weight_;  // smooth_blend: normalised blend weights, parallel to reach_.indices
   std::vector<Index> nearest_;       // per garment vertex: nearest agent (used when reach is empty)
+  Points original_vertices_;         // emit_from_original: the garment's original positions
+  std::vector<Level> levels_;        // coarser levels, finest first
   SurfaceStats stats_;
-  std::shared_ptr<const SurfaceBinding> coarse_;  // the same garment with voxel 2h (null: none)
 };
 
 }  // namespace refit

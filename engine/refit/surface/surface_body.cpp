@@ -1,15 +1,20 @@
 #include <refit/body/body_surface.hpp>
 #include <refit/surface/surface.hpp>
 
+#include <algorithm>
+
 namespace refit {
 
 // Own translation unit: callers of the std::function overload do not need Embree.
 SurfaceResult SurfaceBinding::apply(const Points& warped_vertices, const Points& feature_targets,
                                     const BodySurface& body_b, const Points* feature_warped) const {
-  const double eps = options_.epsilon;
-  // Only "closer than epsilon" matters: the bounded query stops early far from the body.
+  // Only "closer than epsilon" matters, and (for apply's vertex test) a lower bound
+  // a little beyond it: the bounded query stops early far from the body, and
+  // "farther than the bound" is reported as the bound itself.
+  const double bound = options_.epsilon + 2.0 * options_.reach_voxels * h_;
   return apply(warped_vertices, feature_targets,
-               [&body_b, eps](const Vec3& p) { return body_b.closest_within(p, eps).distance; }, feature_warped);
+               [&body_b, bound](const Vec3& p) { return std::min(body_b.closest_within(p, bound).distance, bound); },
+               feature_warped);
 }
 
 }  // namespace refit
