@@ -3,7 +3,8 @@
 // with the hem and four side profiles as features. Skips when ../shared/data is
 // absent. Asserts what holds today (every vertex written, no NaN, no more
 // vertices inside body B than the warp alone leaves, the written garment keeps
-// the curves no worse than the warp) and prints the shape errors.
+// every curve no worse and all together better than the warp) and prints the
+// shape errors.
 #include "support/test_support.hpp"
 
 #include <refit/io/body_io.hpp>
@@ -114,16 +115,19 @@ void resize_to_targets(const RealGarment& rg, const std::vector<std::string>& ta
       ASSERT_TRUE(std::isfinite(output));
       sum_output_warped += output_warped;
       sum_output += output;
+      // No feature comes out of the written garment notably worse than the warp
+      // alone leaves it (1e-4: the skirt's hem is already at 0.0002 after the warp).
+      EXPECT_LT(output, output_warped + 1e-4) << f.at("name");
       std::printf("[ info ]   %-6s shape error: warp %.5f, optimised curve %.5f (%.0fx), written garment %.5f (%.1fx); "
                   "carried on the warped garment %.5f (%.1fx)\n",
                   f.at("name").get<std::string>().c_str(), warped, curve, warped / std::max(curve, 1e-12), output,
                   warped / std::max(output, 1e-12), output_warped, output_warped / std::max(output, 1e-12));
     }
-    // What holds today on these coarse garments (720 to 3091 vertices): the
-    // written garment keeps the feature curves at least as well as the warp alone,
-    // measured alike (samples carried on the garment), within 5% over all
-    // features: 0.99x-1.5x, far from the 10x (see the surface report).
-    EXPECT_LT(sum_output, 1.05 * sum_output_warped);
+    // Over all five features the written garment keeps the curves' shape clearly
+    // better than the warp alone, measured alike (samples carried on the garment's
+    // faces): measured 1.7x-3.5x. Per feature 3x-47x on the hem, front and back,
+    // but only 1.0x-1.6x on the side profiles, whose hip part lies on body B.
+    EXPECT_GT(sum_output_warped, 1.5 * sum_output);
   }
 }
 
