@@ -16,6 +16,7 @@
 #pragma GCC diagnostic pop
 
 #include <algorithm>
+#include <numeric>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -138,7 +139,6 @@ Image render(const BodyMesh& body, const Garment& garment, const Garment* garmen
   scenes.push_back(std::make_unique<Scene>(device.get(), body, garment));
   if (garment2) scenes.push_back(std::make_unique<Scene>(device.get(), body, *garment2));
 
-  // The same framing in every panel, so the pictures compare at a glance.
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   grow(lo, hi, body.vertices);
   grow(lo, hi, garment.positions);
@@ -147,26 +147,31 @@ Image render(const BodyMesh& body, const Garment& garment, const Garment* garmen
   const Vec3 centre = 0.5 * (lo + hi);
   const double depth = (hi - lo).norm() + 1.0;
 
+  // One scale for every panel (views and garments compare at a glance); each
+  // panel is as wide as its view of the box needs, so a front view spread by the
+  // arms is not shrunk to the width of a side view.
   std::vector<Panel> panels;
-  const int count = static_cast<int>(scenes.size() * options.views.size());
+  std::vector<double> across;
+  const Vec3 ext = hi - lo;
   for (int g = 0; g < static_cast<int>(scenes.size()); ++g)
     for (View v : options.views) {
       Panel p;
-      const int index = static_cast<int>(panels.size());
-      p.x0 = index * options.width / count;
-      p.width = (index + 1) * options.width / count - p.x0;
       p.garment = g;
       p.camera = camera_for(v);
+      across.push_back(std::abs(ext.dot(p.camera.right)) + 1e-9);
       panels.push_back(p);
     }
-  // Pixel size per panel: the box's extent across and up the view, with a margin.
-  std::vector<double> pixel(panels.size());
+  const double total = std::accumulate(across.begin(), across.end(), 0.0);
+  double upward = 0.0;
+  for (const Panel& p : panels) upward = std::max(upward, std::abs(ext.dot(p.camera.up)));
+  const double scale = 1.08 * std::max(total / options.width, upward / options.height) + 1e-12;
+  double edge = 0.0;
   for (std::size_t i = 0; i < panels.size(); ++i) {
-    const Camera& c = panels[i].camera;
-    const Vec3 ext = hi - lo;
-    const double across = std::abs(ext.dot(c.right)), upward = std::abs(ext.dot(c.up));
-    pixel[i] = 1.08 * std::max(across / std::max(panels[i].width, 1), upward / options.height) + 1e-12;
+    panels[i].x0 = static_cast<int>(std::lround(edge / total * options.width));
+    edge += across[i];
+    panels[i].width = static_cast<int>(std::lround(edge / total * options.width)) - panels[i].x0;
   }
+  const std::vector<double> pixel(panels.size(), scale);
 
   Image img;
   img.width = options.width;
