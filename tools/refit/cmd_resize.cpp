@@ -20,7 +20,8 @@ struct ResizeArgs {
   std::string garment, from, out, out_dir, report, features, curves_out, units = "cm", stage = "full";
   std::vector<std::string> to;
   std::size_t threads = 0, max_triangles = WarpOptions{}.max_triangles;
-  bool quiet = false, metrics = false, paper_closeness = false, no_shape_control = false, no_collision = false, encode_on_warped = false;
+  bool quiet = false, metrics = false, paper_closeness = false, no_shape_control = false, no_collision = false, encode_on_warped = false,
+       paper_surface = false;
   SurfaceOptions surface;
   double clearance = 0.2;
 };
@@ -46,6 +47,12 @@ int run(const ResizeArgs& a) {
   options.surface = a.surface;
   options.shape_matching.sampling_invariant = !a.paper_closeness;
   options.surface.encode_on_warped = a.encode_on_warped;
+  if (a.paper_surface) {
+    options.surface.fit_rotations = false;
+    options.surface.smooth_blend = false;
+    options.surface.emit_from_original = false;
+    options.surface.smooth_passes = 0;
+  }
   options.collision = !a.no_collision;
   options.metrics = a.metrics;
   options.clearance_cm = a.clearance;
@@ -144,6 +151,8 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
   app.add_option("--max-iterations", a->surface.max_iterations, "Gauss-Seidel iterations, at most")->capture_default_str();
   app.add_option("--tolerance", a->surface.tolerance, "Gauss-Seidel stops below this update norm")->capture_default_str();
   app.add_flag("--encode-on-warped", a->encode_on_warped, "Encode the local shape on the warped garment, not the original");
+  app.add_flag("--paper-surface", a->paper_surface,
+               "Surface reconstruction as the paper: fan-normal frames, eq. 4 blend of the warped vertices, no smoothing");
   app.add_flag("--no-collision", a->no_collision, "Do not push vertices inside body B out");
   app.add_option("--clearance", a->clearance, "Collision clearance outside body B in cm")->capture_default_str();
   app.add_flag("--metrics", a->metrics, "Add fit, penetration and surface metrics of the warp and the result to the report");
