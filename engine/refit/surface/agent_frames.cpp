@@ -164,44 +164,6 @@ AgentFrames agent_frames(const Points& x, const Csr& ring, const std::vector<std
   return f;
 }
 
-Points reconstruct(const Points& v, const AgentFrames& before, const AgentFrames& after, const Csr& reach,
-                   const std::vector<Index>& nearest) {
-  const std::size_t n = static_cast<std::size_t>(v.rows());
-  Points out(v.rows(), 3);
-  parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) {
-      const Vec3 p = row3(v, Index(i));
-      auto r = reach.row(i);
-      Vec3 q;
-      if (r.empty()) {
-        const Index j = nearest[i];
-        q = p + row3(after.origin, j) - row3(before.origin, j);
-      } else {
-        Vec3 sum = Vec3::Zero();
-        double wsum = 0.0;
-        for (Index j : r) {
-          const Vec3 d = p - row3(before.origin, j);
-          Vec3 local, emitted;
-          if (before.valid[j] && after.valid[j]) {
-            local = before.axes[j].transpose() * d;
-            emitted = row3(after.origin, j) + after.axes[j] * local;
-          } else {
-            local = d;
-            emitted = row3(after.origin, j) + d;
-          }
-          const double len = local.norm();
-          const double w = 1.0 / (1e-8 + len * len * len);  // eq. 4
-          sum += w * emitted;
-          wsum += w;
-        }
-        q = sum / wsum;
-      }
-      out.row(static_cast<Eigen::Index>(i)) = q.transpose();
-    }
-  });
-  return out;
-}
-
 std::vector<Eigen::Matrix3d> ring_rotations(const Points& from, const Points& to, const Csr& ring) {
   const std::size_t n = ring.rows();
   std::vector<Eigen::Matrix3d> out(n, Eigen::Matrix3d::Identity());

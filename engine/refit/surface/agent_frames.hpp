@@ -39,13 +39,6 @@ struct AgentFrames {
 AgentFrames agent_frames(const Points& x, const Csr& ring, const std::vector<std::uint8_t>& open,
                          const std::vector<std::int8_t>& flip);
 
-/// Re-emits every vertex (rows of `vertices`, on the `before` state) from the agents
-/// `reach.row(v)` (eq. 4 blending, w = 1/(1e-8 + |local|^3)); an agent whose frame is
-/// invalid in either state moves the vertex by its translation only. A vertex with
-/// an empty list moves with agent nearest[v] (translation only).
-Points reconstruct(const Points& vertices, const AgentFrames& before, const AgentFrames& after, const Csr& reach,
-                   const std::vector<Index>& nearest);
-
 /// Per agent the rotation that best carries its one-ring from `from` to `to`
 /// (least squares over the ring edges a_i - a, Kabsch: SVD of the 3x3 covariance,
 /// determinant fixed to +1). An improvement over the paper's fan frames (section
@@ -56,7 +49,9 @@ Points reconstruct(const Points& vertices, const AgentFrames& before, const Agen
 std::vector<Eigen::Matrix3d> ring_rotations(const Points& from, const Points& to, const Csr& ring);
 
 /// Rotation from `before` to `after` frames per agent (after.axes * before.axes^T;
-/// identity where either frame is invalid): the paper's fan frames as rotations.
+/// identity where either frame is invalid): the paper's fan frames as rotations,
+/// so reconstruct_rotations with these and empty weights is the paper's eq.-4
+/// re-emission (local coordinates in the frame before, emitted from the frame after).
 std::vector<Eigen::Matrix3d> frame_rotations(const AgentFrames& before, const AgentFrames& after);
 
 /// Re-emits every vertex (rows of `vertices`, on the `before` state) from the
