@@ -104,6 +104,20 @@ double max_residual(const AgentRows& rows, const Points& x) {
   return worst;
 }
 
+Points row_residual(const AgentRows& rows, const Points& h, const std::vector<std::uint8_t>& free, const Points& x) {
+  Points r = Points::Zero(x.rows(), 3);
+  parallel_for(0, rows.size(), 2048, [&](std::size_t b, std::size_t e) {
+    for (std::size_t a = b; a < e; ++a) {
+      if (!free[a]) continue;
+      auto ring = rows.ring.row(a);
+      Vec3 s = row3(h, Index(a)) - rows.diag[a] * row3(x, Index(a));
+      for (std::size_t i = 0; i < ring.size(); ++i) s += rows.weight[rows.ring.offsets[a] + i] * row3(x, ring[i]);
+      r.row(Eigen::Index(a)) = s.transpose();
+    }
+  });
+  return r;
+}
+
 double longest_edge(const Points& x, const Csr& ring) {
   double worst = 0.0;
   for (std::size_t a = 0; a < ring.rows(); ++a)

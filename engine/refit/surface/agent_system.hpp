@@ -63,6 +63,10 @@ std::vector<Index> make_block_order(const Points& positions, const std::vector<s
 /// sequential every agent with a one-ring edge to another block of its colour.
 BlockSchedule make_schedule(const Points& positions, const Csr& ring, double block_width);
 
+/// Per agent the row residual h_a + sum_i w_i x_i - diag_a x_a of eq. 13 with the
+/// right-hand side `h` (n x 3); zero where free[a] == 0 (for multigrid corrections).
+Points row_residual(const AgentRows& rows, const Points& h, const std::vector<std::uint8_t>& free, const Points& x);
+
 /// Longest one-ring edge at `positions`.
 double longest_edge(const Points& positions, const Csr& ring);
 
