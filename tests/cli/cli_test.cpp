@@ -86,7 +86,7 @@ TEST(Cli, PaperVariantsRunAndChangeTheResult) {
   const std::string ours = c.dir.file("ours.obj");
   ASSERT_EQ(run_cli(c.resize(ours, feats)).exit_code, 0);
   const Garment base = read_garment_obj(ours);
-  for (const char* flag : {"--paper-surface", "--paper-closeness", "--encode-on-warped"}) {
+  for (const char* flag : {"--paper-surface", "--paper-closeness", "--encode-on-warped", "--plain-sweeps"}) {
     const std::string out = c.dir.file(std::string(flag + 2) + ".obj");
     const auto r = run_cli(c.resize(out, feats + flag));
     ASSERT_EQ(r.exit_code, 0) << flag << ": " << r.err;
