@@ -1,6 +1,7 @@
 // Topology statistics and boundary loops on small hand-made garments, including
 // the non-manifold cases CAD files contain.
 #include <refit/core/error.hpp>
+#include <refit/core/parallel.hpp>
 #include <refit/core/topology.hpp>
 
 #include <gtest/gtest.h>
@@ -8,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <initializer_list>
+#include <map>
 #include <set>
 #include <utility>
 
@@ -166,6 +168,65 @@ TEST(Topology, IndexOutOfRangeThrows) {
   const Garment g = make(3, {{0, 1, 7}});
   EXPECT_THROW(topology_stats(g), Error);
   EXPECT_THROW(boundary_loops(g), Error);
+}
+
+// A grid of W x H quads, large enough for many parallel chunks, with a hole of
+// quads left out, a triangulated band, a repeated-corner face and a fin (a third
+// face on one edge): the edge counts match a plain count, every loop is valid,
+// and one and two threads give the same loops.
+TEST(Topology, LargeGridSameForOneAndTwoThreadsAndMatchesAPlainCount) {
+  const Index W = 240, H = 120;
+  Garment g;
+  g.positions = Points::Zero((W + 1) * (H + 1) + 1, 3);
+  const auto id = [&](Index x, Index y) { return y * (W + 1) + x; };
+  for (Index y = 0; y <= H; ++y)
+    for (Index x = 0; x <= W; ++x) g.positions.row(id(x, y)) << double(x), double(y), 0.0;
+  for (Index y = 0; y < H; ++y)
+    for (Index x = 0; x < W; ++x) {
+      if (x >= 100 && x < 110 && y >= 50 && y < 55) continue;  // the hole
+      if (y == 7) {
+        g.faces.push_row(std::vector<Index>{id(x, y), id(x + 1, y), id(x + 1, y + 1)});
+        g.faces.push_row(std::vector<Index>{id(x, y), id(x + 1, y + 1), id(x, y + 1)});
+      } else if (x == 3 && y == 90) {
+        g.faces.push_row(std::vector<Index>{id(x, y), id(x + 1, y), id(x + 1, y), id(x + 1, y + 1), id(x, y + 1)});
+      } else {
+        g.faces.push_row(std::vector<Index>{id(x, y), id(x + 1, y), id(x + 1, y + 1), id(x, y + 1)});
+      }
+    }
+  g.faces.push_row(std::vector<Index>{id(20, 20), id(21, 20), Index((W + 1) * (H + 1))});  // fin
+  std::map<std::pair<Index, Index>, int> uses;
+  for (std::size_t f = 0; f < g.faces.rows(); ++f) {
+    const auto r = g.faces.row(f);
+    for (std::size_t k = 0; k < r.size(); ++k)
+      if (r[k] != r[(k + 1) % r.size()]) ++uses[std::minmax(r[k], r[(k + 1) % r.size()])];
+  }
+  std::size_t boundary = 0, non_manifold = 0;
+  for (const auto& [e, k] : uses) boundary += k == 1, non_manifold += k >= 3;
+
+  TopologyStats one, two;
+  std::vector<std::vector<Index>> loops_one, loops_two;
+  {
+    const ThreadLimit limit(1);
+    one = topology_stats(g);
+    loops_one = boundary_loops(g);
+  }
+  {
+    const ThreadLimit limit(2);
+    two = topology_stats(g);
+    loops_two = boundary_loops(g);
+  }
+  EXPECT_EQ(one.edges, uses.size());
+  EXPECT_EQ(one.boundary_edges, boundary);
+  EXPECT_EQ(one.non_manifold_edges, 1u);
+  EXPECT_EQ(non_manifold, 1u);
+  EXPECT_EQ(one.edges, two.edges);
+  EXPECT_EQ(one.boundary_edges, two.boundary_edges);
+  EXPECT_EQ(one.boundary_loops, two.boundary_loops);
+  EXPECT_EQ(loops_one, loops_two);
+  ASSERT_EQ(loops_one.size(), 2u);  // the rim and the hole (the fin's two edges end without closing)
+  EXPECT_EQ(loops_one[0].size(), 2u * (W + H));
+  EXPECT_EQ(loops_one[1].size(), 2u * (10 + 5));
+  expect_valid_loops(g, loops_one);
 }
 
 }  // namespace

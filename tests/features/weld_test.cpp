@@ -1,6 +1,8 @@
 // weld_points: the parallel pre-filter must not change what the documented rule
 // gives (in row order, join the lowest-numbered representative within tol).
 #include <refit/core/parallel.hpp>
+#include <refit/core/topology.hpp>
+#include <refit/features/feature_curves.hpp>
 #include <refit/features/slice.hpp>
 
 #include <gtest/gtest.h>
@@ -84,3 +86,76 @@ TEST(Weld, NonPositiveToleranceWeldsNothing) {
 }
 
 }  // namespace
+
+// A 200 x 100 quad grid cut down the middle (the seam's vertices duplicated),
+// with one quad whose corners all fall within the tolerance (it collapses) and
+// one whose two corners weld (it becomes a triangle): welded, the faces are the
+// documented rule applied row by row, one and two threads agree, and the seam
+// no longer shows as boundary.
+TEST(Weld, WeldGarmentRebuildsFacesAsTheRuleSaysForAnyThreadCount) {
+  const Index W = 200, H = 100, half = W / 2;
+  Garment g;
+  std::vector<Vec3> pts;
+  std::vector<Index> left((W + 1) * (H + 1)), right((W + 1) * (H + 1));
+  for (Index y = 0; y <= H; ++y)
+    for (Index x = 0; x <= W; ++x) {
+      const Index k = y * (W + 1) + x;
+      const double dx = (x == 51 && y == 40) ? -0.99999 : 0.0;  // welds onto (50, 40)
+      left[k] = static_cast<Index>(pts.size());
+      pts.emplace_back(double(x) + dx, double(y), 0.0);
+      right[k] = left[k];
+      if (x == half) {
+        right[k] = static_cast<Index>(pts.size());
+        pts.emplace_back(double(x), double(y), 0.0);
+      }
+    }
+  g.positions.resize(static_cast<Eigen::Index>(pts.size()), 3);
+  for (std::size_t i = 0; i < pts.size(); ++i) g.positions.row(static_cast<Eigen::Index>(i)) = pts[i].transpose();
+  for (Index y = 0; y < H; ++y)
+    for (Index x = 0; x < W; ++x) {
+      const auto& v = x < half ? left : right;
+      const Index k = y * (W + 1) + x;
+      g.faces.push_row(std::vector<Index>{v[k], v[k + 1], v[k + W + 2], v[k + W + 1]});
+    }
+  const double tol = 1e-4;
+  const std::vector<Index> rep = weld_points(g.positions, tol);
+  Garment expected;
+  for (std::size_t f = 0; f < g.faces.rows(); ++f) {
+    std::vector<Index> row;
+    for (Index v : g.faces.row(f))
+      if (row.empty() || row.back() != rep[v]) row.push_back(rep[v]);
+    while (row.size() > 1 && row.back() == row.front()) row.pop_back();
+    if (row.size() >= 3) expected.faces.push_row(row);
+  }
+  ASSERT_EQ(expected.faces.rows(), g.faces.rows()) << "no face collapses in this case";
+  Garment one, two;
+  {
+    const ThreadLimit limit(1);
+    one = weld_garment(g, tol);
+  }
+  {
+    const ThreadLimit limit(2);
+    two = weld_garment(g, tol);
+  }
+  EXPECT_EQ(one.faces.offsets, expected.faces.offsets);
+  EXPECT_EQ(one.faces.indices, expected.faces.indices);
+  EXPECT_EQ(two.faces.offsets, expected.faces.offsets);
+  EXPECT_EQ(two.faces.indices, expected.faces.indices);
+  std::size_t triangles = 0;
+  for (std::size_t f = 0; f < one.faces.rows(); ++f) triangles += one.faces.row_size(f) == 3;
+  EXPECT_EQ(triangles, 2u);  // the two quads at the welded corner
+  EXPECT_EQ(boundary_loops(g).size(), 2u);    // the two halves
+  EXPECT_EQ(boundary_loops(one).size(), 1u);  // one rim
+}
+
+// A quad whose corners all weld into one point is dropped.
+TEST(Weld, WeldGarmentDropsCollapsedFaces) {
+  Garment g;
+  g.positions.resize(6, 3);
+  g.positions << 0, 0, 0, 1e-9, 0, 0, 1e-9, 1e-9, 0, 0, 1e-9, 0, 1, 0, 0, 1, 1, 0;
+  g.faces.push_row(std::vector<Index>{0, 1, 2, 3});
+  g.faces.push_row(std::vector<Index>{1, 4, 5, 2});
+  const Garment w = weld_garment(g, 1e-6);
+  ASSERT_EQ(w.faces.rows(), 1u);
+  EXPECT_EQ(std::vector<Index>(w.faces.row(0).begin(), w.faces.row(0).end()), (std::vector<Index>{0, 4, 5}));
+}

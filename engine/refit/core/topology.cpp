@@ -2,9 +2,11 @@
 
 #include <refit/core/error.hpp>
 
-#include <tbb/parallel_sort.h>
+#include <refit/core/parallel.hpp>
 
 #include <algorithm>
+
+#include <atomic>
 #include <numeric>
 #include <string>
 
@@ -32,21 +34,58 @@ void check_indices(const Garment& g) {
   check(g.points, "point");
 }
 
-/// Every face edge (consecutive corners, wrapping), sorted; an edge used by k
-/// face sides appears k times. Repeated-vertex (zero-length) sides are skipped.
-std::vector<std::uint64_t> sorted_face_edges(const Garment& g) {
-  std::vector<std::uint64_t> keys;
-  keys.reserve(g.faces.indices.size());
-  for (std::size_t f = 0; f < g.faces.rows(); ++f) {
-    const auto row = g.faces.row(f);
-    for (std::size_t k = 0; k < row.size(); ++k) {
-      const Index a = row[k], b = row[(k + 1) % row.size()];
-      if (a != b) keys.push_back(edge_key(a, b));
+/// Every face side (consecutive corners, wrapping) as an undirected edge,
+/// bucketed by its smaller vertex: bucket v holds the larger vertices, sorted,
+/// in hi[start[v], start[v+1]); an edge used by k face sides appears k times.
+/// Repeated-vertex (zero-length) sides are skipped. Built in parallel: the fill
+/// order within a bucket varies with the threads, the sorted buckets do not.
+struct FaceEdges {
+  std::vector<Index> start, hi;
+};
+
+FaceEdges face_edges(const Garment& g) {
+  const std::size_t n = g.vertex_count(), faces = g.faces.rows();
+  constexpr std::size_t kGrain = 1 << 14;
+  const auto each_side = [&](std::size_t begin, std::size_t end, auto&& f) {
+    for (std::size_t r = begin; r < end; ++r) {
+      const auto row = g.faces.row(r);
+      for (std::size_t k = 0; k < row.size(); ++k) {
+        const Index a = row[k], b = row[k + 1 == row.size() ? 0 : k + 1];
+        if (a != b) f(std::min(a, b), std::max(a, b));
+      }
     }
-  }
-  // Equal keys are identical, so the sorted result is the same for any thread count.
-  tbb::parallel_sort(keys.begin(), keys.end());
-  return keys;
+  };
+  FaceEdges e;
+  e.start.assign(n + 1, 0);
+  parallel_for(0, faces, kGrain, [&](std::size_t b, std::size_t end) {
+    each_side(b, end, [&](Index lo, Index) { std::atomic_ref<Index>(e.start[lo + 1]).fetch_add(1, std::memory_order_relaxed); });
+  });
+  for (std::size_t v = 0; v < n; ++v) e.start[v + 1] += e.start[v];
+  e.hi.resize(e.start[n]);
+  std::vector<Index> fill(e.start.begin(), e.start.end() - 1);
+  parallel_for(0, faces, kGrain, [&](std::size_t b, std::size_t end) {
+    each_side(b, end, [&](Index lo, Index h) {
+      e.hi[std::atomic_ref<Index>(fill[lo]).fetch_add(1, std::memory_order_relaxed)] = h;
+    });
+  });
+  parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t end) {
+    for (std::size_t v = b; v < end; ++v) std::sort(e.hi.begin() + e.start[v], e.hi.begin() + e.start[v + 1]);
+  });
+  return e;
+}
+
+/// Calls f(lo, hi, k) for each distinct edge, k = how many face sides use it,
+/// in key order.
+template <class F>
+void for_each_edge(const FaceEdges& e, F&& f) {
+  const std::size_t n = e.start.size() - 1;
+  for (std::size_t v = 0; v < n; ++v)
+    for (Index i = e.start[v]; i < e.start[v + 1];) {
+      Index j = i + 1;
+      while (j < e.start[v + 1] && e.hi[j] == e.hi[i]) ++j;
+      f(static_cast<Index>(v), e.hi[i], j - i);
+      i = j;
+    }
 }
 
 struct UnionFind {
@@ -66,7 +105,7 @@ struct UnionFind {
   }
 };
 
-std::vector<std::vector<Index>> loops_from_edges(const Garment& g, const std::vector<std::uint64_t>& keys);
+std::vector<std::vector<Index>> loops_from_edges(const Garment& g, const FaceEdges& edges);
 
 }  // namespace
 
@@ -78,15 +117,12 @@ TopologyStats topology_stats(const Garment& g) {
   s.lines = g.lines.rows();
   s.points = g.points.rows();
 
-  const std::vector<std::uint64_t> keys = sorted_face_edges(g);
-  for (std::size_t i = 0; i < keys.size();) {
-    std::size_t j = i + 1;
-    while (j < keys.size() && keys[j] == keys[i]) ++j;
+  const FaceEdges edges = face_edges(g);
+  for_each_edge(edges, [&](Index, Index, Index k) {
     ++s.edges;
-    if (j - i == 1) ++s.boundary_edges;
-    if (j - i >= 3) ++s.non_manifold_edges;
-    i = j;
-  }
+    if (k == 1) ++s.boundary_edges;
+    if (k >= 3) ++s.non_manifold_edges;
+  });
 
   UnionFind uf(s.vertices);
   std::vector<std::uint8_t> used(s.vertices, 0);
@@ -104,26 +140,23 @@ TopologyStats topology_stats(const Garment& g) {
     if (!used[v]) ++s.unreferenced_vertices;
     else if (uf.find(static_cast<Index>(v)) == v) ++s.components;
   }
-  s.boundary_loops = loops_from_edges(g, keys).size();
+  s.boundary_loops = loops_from_edges(g, edges).size();
   return s;
 }
 
 std::vector<std::vector<Index>> boundary_loops(const Garment& g) {
   check_indices(g);
-  return loops_from_edges(g, sorted_face_edges(g));
+  return loops_from_edges(g, face_edges(g));
 }
 
 namespace {
 
-std::vector<std::vector<Index>> loops_from_edges(const Garment& g, const std::vector<std::uint64_t>& keys) {
+std::vector<std::vector<Index>> loops_from_edges(const Garment& g, const FaceEdges& edges) {
   // Boundary edges (used once), in key order.
   std::vector<std::uint64_t> boundary;
-  for (std::size_t i = 0; i < keys.size();) {
-    std::size_t j = i + 1;
-    while (j < keys.size() && keys[j] == keys[i]) ++j;
-    if (j - i == 1) boundary.push_back(keys[i]);
-    i = j;
-  }
+  for_each_edge(edges, [&](Index lo, Index hi, Index k) {
+    if (k == 1) boundary.push_back(edge_key(lo, hi));
+  });
   if (boundary.empty()) return {};
 
   // Boundary edges at each vertex (CSR, edge ids ascending), to chain them.
@@ -147,15 +180,20 @@ std::vector<std::vector<Index>> loops_from_edges(const Garment& g, const std::ve
   // The direction a face gives each boundary edge, so loops follow the faces'
   // orientation where they are consistent.
   std::vector<std::uint8_t> forward(boundary.size(), 1);  // lo -> hi
-  for (std::size_t f = 0; f < g.faces.rows(); ++f) {
-    const auto row = g.faces.row(f);
-    for (std::size_t k = 0; k < row.size(); ++k) {
-      const Index a = row[k], b = row[(k + 1) % row.size()];
-      if (a == b) continue;
-      const auto it = std::lower_bound(boundary.begin(), boundary.end(), edge_key(a, b));
-      if (it != boundary.end() && *it == edge_key(a, b)) forward[std::size_t(it - boundary.begin())] = a < b;
+  std::vector<std::uint8_t> on_boundary(n, 0);
+  for (std::uint64_t k : boundary) on_boundary[key_lo(k)] = on_boundary[key_hi(k)] = 1;
+  // A boundary edge has exactly one face side, so exactly one iteration writes it.
+  parallel_for(0, g.faces.rows(), 1 << 14, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t f = begin; f < end; ++f) {
+      const auto row = g.faces.row(f);
+      for (std::size_t k = 0; k < row.size(); ++k) {
+        const Index a = row[k], b = row[(k + 1) % row.size()];
+        if (a == b || !on_boundary[a] || !on_boundary[b]) continue;
+        const auto it = std::lower_bound(boundary.begin(), boundary.end(), edge_key(a, b));
+        if (it != boundary.end() && *it == edge_key(a, b)) forward[std::size_t(it - boundary.begin())] = a < b;
+      }
     }
-  }
+  });
 
   // Walk from each unused edge; at a vertex with several unused boundary edges
   // take the one with the smallest id. Coming back to a vertex already on the

@@ -1,6 +1,7 @@
 #include <refit/features/feature_curves.hpp>
 
 #include <refit/core/error.hpp>
+#include <refit/core/parallel.hpp>
 #include <refit/core/topology.hpp>
 #include <refit/features/bspline.hpp>
 #include <refit/features/slice.hpp>
@@ -27,12 +28,22 @@ std::string fmt(double v) {
 
 void check_plane_hits(const Garment& g, const FeatureSpec& s) {
   if (!s.plane) return;
+  // Per-block extremes, then their extremes: min and max do not depend on the
+  // order, so neither does the result.
+  constexpr std::size_t kBlock = 1 << 15;
+  const std::size_t n = g.vertex_count(), blocks = (n + kBlock - 1) / kBlock;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  std::vector<double> block_lo(blocks, kInf), block_hi(blocks, -kInf);
+  parallel_for(0, blocks, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t blk = b; blk < e; ++blk)
+      for (std::size_t i = blk * kBlock; i < std::min(n, (blk + 1) * kBlock); ++i) {
+        const double d = s.plane->signed_distance(row3(g.positions, static_cast<Index>(i)));
+        block_lo[blk] = std::min(block_lo[blk], d);
+        block_hi[blk] = std::max(block_hi[blk], d);
+      }
+  });
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (Eigen::Index i = 0; i < g.positions.rows(); ++i) {
-    const double d = s.plane->signed_distance(row3(g.positions, static_cast<Index>(i)));
-    lo = std::min(lo, d);
-    hi = std::max(hi, d);
-  }
+  for (std::size_t blk = 0; blk < blocks; ++blk) lo = std::min(lo, block_lo[blk]), hi = std::max(hi, block_hi[blk]);
   if (lo > 0.0 || hi < 0.0)
     fail(s, "the plane misses the garment (the whole garment lies " + fmt(lo > 0.0 ? lo : -hi) +
                 " units to one side of it)");
@@ -86,7 +97,7 @@ Points sub_polyline(const Points& poly, bool closed, PolylinePoint a, PolylinePo
 
 FeatureCurve build_slice(const Garment& g, const FeatureSpec& s, double diag, const FeatureCurveOptions& o,
                          std::uint64_t stream) {
-  const SliceResult cut = slice_garment(g, *s.plane);
+  const SliceResult cut = slice_garment(g, *s.plane, 1e-6 * diag);  // the default tolerance, diagonal known
   if (cut.pieces.empty()) fail(s, "the plane cuts none of the garment's faces");
   std::size_t best = 0;
   double best_d = std::numeric_limits<double>::infinity();
@@ -119,7 +130,7 @@ FeatureCurve build_slice(const Garment& g, const FeatureSpec& s, double diag, co
 
 FeatureCurve build_boundary(const Garment& g, const FeatureSpec& s, double diag, const FeatureCurveOptions& o,
                             std::uint64_t stream) {
-  const Garment w = weld_garment(g);
+  const Garment w = weld_garment(g, 1e-6 * diag);  // the default tolerance, diagonal known
   const std::vector<std::vector<Index>> loops = boundary_loops(w);
   if (loops.empty()) fail(s, "the garment's faces have no boundary");
   std::size_t best = 0;
@@ -200,16 +211,44 @@ Garment weld_garment(const Garment& g, double tolerance) {
   const std::vector<Index> rep = weld_points(g.positions, tolerance);
   Garment w;
   w.positions = g.positions;  // unused vertices stay; boundary_loops ignores them
-  std::vector<Index> row;
-  for (std::size_t f = 0; f < g.faces.rows(); ++f) {
-    row.clear();
-    for (Index v : g.faces.row(f)) {
+  // Each face's welded corners (consecutive repeats dropped, also across the
+  // wrap); faces left with fewer than 3 are dropped. Sizes first, then the
+  // rows in place: the same CSR for any thread count.
+  const auto welded = [&](std::size_t f, Index* out) {
+    const auto row = g.faces.row(f);
+    std::size_t k = 0;
+    for (Index v : row) {
       const Index r = rep[v];
-      if (row.empty() || row.back() != r) row.push_back(r);
+      if (k == 0 || out[k - 1] != r) out[k++] = r;
     }
-    while (row.size() > 1 && row.back() == row.front()) row.pop_back();
-    if (row.size() >= 3) w.faces.push_row(row);
-  }
+    while (k > 1 && out[k - 1] == out[0]) --k;
+    return k >= 3 ? k : 0;
+  };
+  const std::size_t faces = g.faces.rows();
+  constexpr std::size_t kGrain = 1 << 14;
+  std::vector<Index> size(faces);
+  parallel_for(0, faces, kGrain, [&](std::size_t b, std::size_t e) {
+    std::vector<Index> row;
+    for (std::size_t f = b; f < e; ++f) {
+      row.resize(g.faces.row_size(f));
+      size[f] = static_cast<Index>(welded(f, row.data()));
+    }
+  });
+  std::vector<Index> kept;  // faces that stay, in order
+  for (std::size_t f = 0; f < faces; ++f)
+    if (size[f] > 0) kept.push_back(static_cast<Index>(f));
+  w.faces.offsets.resize(kept.size() + 1);
+  w.faces.offsets[0] = 0;
+  for (std::size_t r = 0; r < kept.size(); ++r) w.faces.offsets[r + 1] = w.faces.offsets[r] + size[kept[r]];
+  w.faces.indices.resize(w.faces.offsets.back());
+  parallel_for(0, kept.size(), kGrain, [&](std::size_t b, std::size_t e) {
+    std::vector<Index> row;
+    for (std::size_t r = b; r < e; ++r) {
+      row.resize(g.faces.row_size(kept[r]));
+      welded(kept[r], row.data());
+      std::copy_n(row.begin(), w.faces.row_size(r), w.faces.indices.begin() + w.faces.offsets[r]);
+    }
+  });
   return w;
 }
 

@@ -60,9 +60,9 @@ std::vector<Index> weld_points(const Points& p, double tol) {
   for (std::size_t i = 0; i < n; ++i) rep[i] = static_cast<Index>(i);
   if (!(tol > 0.0) || n < 2) return rep;
 
-  // Cells of 4 tol: the tol-box around a point touches 1 or 2 cells per axis
-  // (about 3.4 in all, not 27).
-  const double cell = 4.0 * tol, reach = 1.01 * tol;
+  // Cells of 32 tol: the tol-box around a point usually stays in its own cell
+  // (about 1.2 cells visited on average, each a likely cache miss below).
+  const double cell = 32.0 * tol, reach = 1.01 * tol;
   const double inv = 1.0 / cell;
   const auto cell_of = [inv](double v) { return static_cast<std::int64_t>(std::floor(v * inv)); };
   const auto box = [&](std::size_t i, auto&& visit) {
@@ -80,18 +80,25 @@ std::vector<Index> weld_points(const Points& p, double tol) {
   };
 
   // 1. Which points may have another point within tol, in parallel: occupied
-  // cells hashed into bit sets ("one point", "two or more") of 64 bits per point,
-  // so a collision (which only adds a candidate, never loses one) is rare. Most
-  // points of a garment have no twin and are done here.
-  std::size_t bits = 1 << 16;
-  while (bits < 64 * n) bits *= 2;
-  const std::size_t mask = bits - 1;
-  std::vector<std::atomic<std::uint64_t>> once(bits / 64), twice(bits / 64);
+  // cells go into filters "one point" and "two or more": a cell sets two hashed
+  // bits of one hashed 64-bit word (one cache miss per cell; 16 bits per point,
+  // so the sets stay small enough for the cache). A collision only adds a
+  // candidate, never loses one, and the final result does not depend on which
+  // extra candidates there are (they find no twin in step 2). Most points of a
+  // garment have no twin and are done here.
+  std::size_t words = 1 << 10;
+  while (64 * words < 16 * n) words *= 2;
+  const std::size_t mask = words - 1;
+  const auto slot = [mask](const std::array<std::int64_t, 3>& k) {
+    const std::uint64_t h = CellHash{}(k);
+    return std::pair<std::size_t, std::uint64_t>(h & mask, (std::uint64_t(1) << ((h >> 40) & 63)) |
+                                                               (std::uint64_t(1) << ((h >> 52) & 63)));
+  };
+  std::vector<std::atomic<std::uint64_t>> once(words), twice(words);
   parallel_for(0, n, 1 << 14, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
-      const std::size_t h = CellHash{}(own_cell(i)) & mask;
-      const std::uint64_t bit = std::uint64_t(1) << (h % 64);
-      if (once[h / 64].fetch_or(bit, std::memory_order_relaxed) & bit) twice[h / 64].fetch_or(bit, std::memory_order_relaxed);
+      const auto [w, bits] = slot(own_cell(i));
+      if ((once[w].fetch_or(bits, std::memory_order_relaxed) & bits) == bits) twice[w].fetch_or(bits, std::memory_order_relaxed);
     }
   });
   std::vector<std::uint8_t> candidate(n, 0);
@@ -99,10 +106,9 @@ std::vector<Index> weld_points(const Points& p, double tol) {
     for (std::size_t i = b; i < e; ++i) {
       const auto own = own_cell(i);
       box(i, [&](const std::array<std::int64_t, 3>& k) {
-        const std::size_t h = CellHash{}(k) & mask;
-        const std::uint64_t bit = std::uint64_t(1) << (h % 64);
+        const auto [w, bits] = slot(k);
         const auto& set = k == own ? twice : once;  // its own cell counts only with another point in it
-        candidate[i] = (set[h / 64].load(std::memory_order_relaxed) & bit) ? 1 : 0;
+        candidate[i] = (set[w].load(std::memory_order_relaxed) & bits) == bits ? 1 : 0;
         return !candidate[i];
       });
     }
