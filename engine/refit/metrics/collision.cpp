@@ -100,11 +100,8 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   if (!(options.clearance >= 0.0)) throw Error("penetration resolution: the clearance must be >= 0");
   const std::size_t n = static_cast<std::size_t>(positions.rows());
   CollisionReport report;
-  std::vector<Constraint> con(n);
   std::vector<Index> to_check;  // empty in round 1: check everything
   std::vector<Index> touched;   // every vertex any round may have moved
-  Csr adj;
-  bool have_adj = false;
   std::vector<int> ring(n, -1);
   std::vector<std::uint8_t> finite(n, 0);
   parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
@@ -114,32 +111,54 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   std::vector<std::uint8_t> is_touched(n, 0);
   std::vector<Vec3> first_position;  // aligned with `touched`: where each started
 
-  for (int round = 0; round < std::max(1, options.max_rounds); ++round) {
-    // 1. Which vertices are inside or too close, and where they must go.
-    const std::size_t count = round == 0 ? n : to_check.size();
-    parallel_for(0, count, kGrain / 4, [&](std::size_t b, std::size_t e) {
-      for (std::size_t k = b; k < e; ++k) {
-        const std::size_t i = round == 0 ? k : to_check[k];
-        con[i] = finite[i] ? check_vertex(row3(positions, static_cast<Index>(i)), body_b, options.clearance) : Constraint{};
+  // The adjacency is built while the body readies its inside test (its first
+  // call builds a lookup grid, a serial step): at two threads or more both
+  // are done at once. Bit-identical either way; neither depends on the other.
+  Csr adj;
+  parallel_for(0, 2, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t task = b; task < e; ++task) {
+      if (task == 1) {
+        adj = vertex_adjacency(g);
+        continue;
       }
-    });
-    std::vector<Index> active;
-    for (std::size_t k = 0; k < count; ++k) {
-      const std::size_t i = round == 0 ? k : to_check[k];
-      if (con[i].active) active.push_back(static_cast<Index>(i));
+      for (std::size_t i = 0; i < n; ++i)
+        if (finite[i]) {
+          body_b.inside(row3(positions, static_cast<Index>(i)));
+          break;
+        }
     }
+  });
+
+  for (int round = 0; round < std::max(1, options.max_rounds); ++round) {
+    // 1. Which vertices are inside or too close, and where they must go: fixed
+    // blocks, each listing its constrained vertices, joined in block order.
+    const std::size_t count = round == 0 ? n : to_check.size();
+    constexpr std::size_t kBlock = kGrain / 4;
+    std::vector<std::vector<std::pair<Index, Constraint>>> found((count + kBlock - 1) / kBlock);
+    parallel_for(0, found.size(), 1, [&](std::size_t b, std::size_t e) {
+      for (std::size_t blk = b; blk < e; ++blk)
+        for (std::size_t k = blk * kBlock; k < std::min(count, (blk + 1) * kBlock); ++k) {
+          const Index i = round == 0 ? static_cast<Index>(k) : to_check[k];
+          if (!finite[i]) continue;
+          const Constraint c = check_vertex(row3(positions, i), body_b, options.clearance);
+          if (c.active) found[blk].emplace_back(i, c);
+        }
+    });
+    std::vector<Index> active;  // ascending
+    std::vector<Constraint> con;  // aligned with `active`
+    for (const auto& list : found)
+      for (const auto& [i, c] : list) {
+        active.push_back(i);
+        con.push_back(c);
+      }
     if (round == 0) {
       report.too_close = active.size();
-      for (Index i : active) report.inside_before += con[i].inside ? 1 : 0;
+      for (const Constraint& c : con) report.inside_before += c.inside ? 1 : 0;
     }
     if (active.empty()) break;
     report.rounds = round + 1;
 
     // 2. The region a correction may spread over: up to smoothing_rings edges away.
-    if (!have_adj) {
-      adj = vertex_adjacency(g);
-      have_adj = true;
-    }
     std::vector<Index> region = active;
     for (Index i : active) ring[i] = 0;
     for (std::size_t head = 0, level_end = region.size(), level = 0;
@@ -179,11 +198,15 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
         }
       }
     });
+    // The constraint of each region slot, if any (both lists ascending).
+    std::vector<const Constraint*> con_at(m, nullptr);
+    for (std::size_t k = 0, a = 0; k < m && a < active.size(); ++k)
+      if (region[k] == active[a]) con_at[k] = &con[a++];
     auto enforce = [&](std::size_t k, Vec3& d) {
-      const Constraint& c = con[region[k]];
-      if (ring[region[k]] != 0 || !c.active) return;
-      const double along = d.dot(c.dir);
-      if (along < c.amount) d += (c.amount - along) * c.dir;
+      const Constraint* c = con_at[k];
+      if (!c) return;
+      const double along = d.dot(c->dir);
+      if (along < c->amount) d += (c->amount - along) * c->dir;
     };
     for (std::size_t k = 0; k < m; ++k) enforce(k, disp[k]);
     for (int pass = 0; pass < options.smoothing_passes; ++pass) {
