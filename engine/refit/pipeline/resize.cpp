@@ -81,8 +81,6 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
     clock.reset();
     progress.stage("sampling " + std::to_string(features.size()) + " feature curves");
     features_ = bind_features(body_a_, build_feature_curves(*garment_, features), options_.shape_matching);
-    if (options_.stage == Stage::Full)
-      for (const FeatureCurve& c : features_->model.curves) feature_attachments_.push_back(attach_points(*garment_, c.samples));
     bind_report_["features"] = clock.ms();
   }
   if (options_.stage == Stage::Full) {
@@ -94,7 +92,11 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
     std::vector<const Points*> samples;
     if (features_)
       for (const FeatureCurve& c : features_->model.curves) samples.push_back(&c.samples);
-    surface_ = SurfaceBinding::bind(*garment_, concat_rows(samples), so);
+    const Points all = concat_rows(samples);
+    // One pass over the garment for every curve's samples; the surface binding
+    // and the report's shape_error_output share it.
+    if (all.rows() > 0) feature_attachment_ = attach_points(*garment_, all);
+    surface_ = SurfaceBinding::bind(*garment_, all, so, all.rows() > 0 ? &feature_attachment_ : nullptr);
     bind_report_["surface"] = clock.ms();
   }
 }
@@ -176,13 +178,17 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
 
     // How the written surface carries each feature (not just the optimised curve).
     auto& list = report["features"];
+    const Points on_result = carry(feature_attachment_, result.positions);
+    const Points on_warp = carry(feature_attachment_, result.warped);
+    Eigen::Index first = 0;
     for (std::size_t i = 0; i < curves.curves.size(); ++i) {
       const CurveResult& c = curves.curves[i];
-      list[i]["shape_error_output"] = shape_error(carry(feature_attachments_[i], result.positions), c.original, c.closed);
+      const Eigen::Index m = c.original.rows();
+      list[i]["shape_error_output"] = shape_error(on_result.middleRows(first, m), c.original, c.closed);
       // The same measure on the warped garment: on a coarse mesh, carrying samples
       // on its faces adds faceting that the free-point warp of the samples has not.
-      list[i]["shape_error_output_warped"] =
-          shape_error(carry(feature_attachments_[i], result.warped), c.original, c.closed);
+      list[i]["shape_error_output_warped"] = shape_error(on_warp.middleRows(first, m), c.original, c.closed);
+      first += m;
     }
   }
   if (!result.positions.allFinite()) throw Error("internal: the surface step produced a non-finite position");

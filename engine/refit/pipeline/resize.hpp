@@ -69,7 +69,7 @@ class GarmentBinding {
   WarpBinding warp_;
   std::optional<FeatureBinding> features_;
   std::optional<SurfaceBinding> surface_;
-  std::vector<SurfaceAttachment> feature_attachments_;  // where each feature's samples sit on the garment
+  SurfaceAttachment feature_attachment_;  // where the feature samples (all curves, in order) sit on the garment
   nlohmann::json bind_report_;
 };
 

@@ -126,7 +126,8 @@ void interpolation(const Points& fine, const Points& coarse, std::size_t k, doub
 
 }  // namespace
 
-SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, const SurfaceOptions& options) {
+SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, const SurfaceOptions& options,
+                                    const SurfaceAttachment* feature_attachment) {
   check_options(options);
   check_finite(features, "feature sample");
   SurfaceBinding s;
@@ -331,7 +332,12 @@ SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, co
     st.vertices_capped = std::accumulate(capped.begin(), capped.end(), std::size_t{0});
     for (std::size_t v = 0; v < nv; ++v) st.vertices_without_agent += count[v] == 0;
     // Feature samples without a warped position move with the garment where they sit.
-    if (nf > 0 && nv > 0) s.feature_attachment_ = attach_points(g, features);
+    if (nf > 0 && nv > 0) {
+      if (feature_attachment && feature_attachment->vertex.size() != nf)
+        throw Error("surface: the feature attachment has " + std::to_string(feature_attachment->vertex.size()) +
+                    " samples, the features " + std::to_string(nf));
+      s.feature_attachment_ = feature_attachment ? *feature_attachment : attach_points(g, features);
+    }
   } else {
     s.reach_.offsets.assign(nv + 1, 0);
   }

@@ -91,8 +91,10 @@ class SurfaceBinding {
   /// Binds `original` and the original positions of all feature samples
   /// (concatenated; they become agents, and a garment agent sharing a voxel with
   /// one is dropped). Throws refit::Error on invalid options, non-finite
-  /// positions or bad indices.
-  static SurfaceBinding bind(const Garment& original, const Points& feature_samples, const SurfaceOptions& options = {});
+  /// positions or bad indices. `feature_attachment`: attach_points(original,
+  /// feature_samples) when the caller has it already (it is computed otherwise).
+  static SurfaceBinding bind(const Garment& original, const Points& feature_samples, const SurfaceOptions& options = {},
+                             const SurfaceAttachment* feature_attachment = nullptr);
 
   /// With coarse levels, the free agents start from the solution on the next
   /// coarser agent subset (voxel 2h), interpolated: Gauss-Seidel removes smooth
