@@ -40,8 +40,8 @@ struct SurfaceOptions {
   bool multigrid = true;           // V-cycles with Galerkin coarse operators after the coarse-to-fine start (false: plain sweeps)
   int multigrid_sweeps = 2;        // Gauss-Seidel sweeps before and after each coarse correction
   int coarsest_sweeps = 50;        // sweeps of the coarsest correction
-  double multigrid_overcorrection = 1.5;  // aggregation's usual factor on the coarse correction (measured on the 40k
-                                          // demo dress: 164 fine sweeps to the 1e-5 update with 1.0, 112 with 1.5)
+  double multigrid_overcorrection = 1.5;  // aggregation's usual factor on each coarse correction (measured on the 40k
+                                          // demo dress: 164 fine sweeps to the 1e-5 update with 1.0, 82 with 1.5)
   // Beyond the paper (each documented where it is used; false gives the paper's way):
   bool rotate_encoding = false;    // turn each h (eq. 12) with the agent's ring rotation from the original to the warp (measured worse: see apply)
   bool fit_rotations = true;       // frames as least-squares ring rotations instead of fan normal + one-neighbour tangent
