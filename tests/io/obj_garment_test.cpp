@@ -183,6 +183,29 @@ TEST(ObjWrite, RoundTripChangesOnlyVertexAndNormalLines) {
   EXPECT_EQ(r.source->normals(2, 0), 1.0);
 }
 
+TEST(ObjWrite, OtherPositionsWriteLikeACopyWithThemAndCheckTheirCount) {
+  // A resize result is written with the original garment's elements and source
+  // (no copy of the garment): the same bytes as a copy given those positions.
+  test::TempDir dir;
+  const Garment g = parse_garment_obj(rich_obj(), "rich.obj");
+  Points moved = g.positions;
+  moved.col(1).array() += 0.25;
+  Garment copy = g;
+  copy.positions = moved;
+  const std::string a = dir.file("a.obj"), b = dir.file("b.obj");
+  const ObjWriteReport ra = write_garment_obj(a, copy), rb = write_garment_obj(b, g, moved);
+  EXPECT_EQ(test::read_text(a), test::read_text(b));
+  EXPECT_EQ(ra.normals_recomputed, rb.normals_recomputed);
+  try {
+    write_garment_obj(dir.file("c.obj"), g, Points(moved.topRows(3)));
+    FAIL() << "no error for 3 positions";
+  } catch (const Error& e) {
+    EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr("c.obj"));
+    EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr("3 positions"));
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("c.obj")));
+}
+
 TEST(ObjWrite, UnchangedGarmentIsByteIdentical) {
   const std::string text = rich_obj() + "v 1.50 -0.0 1e2\n";
   const Garment g = parse_garment_obj(text, "same.obj");

@@ -83,9 +83,7 @@ int run(const ResizeArgs& a) {
       const std::string out = a.out_dir.empty() ? a.out : (std::filesystem::path(a.out_dir) / (body_b.name + ".obj")).string();
       clock.reset();
       progress.stage("writing " + out);
-      Garment resized = *garment;
-      resized.positions = std::move(result.positions);
-      const ObjWriteReport written = write_garment_obj(out, resized);
+      const ObjWriteReport written = write_garment_obj(out, *garment, result.positions);
       if (!a.curves_out.empty()) write_curves_obj(a.curves_out, result.features);
       nlohmann::json& r = result.report;
       r["timings_ms"]["write"] = clock.ms();

@@ -464,7 +464,7 @@ std::string join(std::vector<std::string>& parts) {
 using Parts = std::vector<std::string>;
 
 // A plain OBJ for garments that come from no file.
-Parts format_plain(const Garment& g) {
+Parts format_plain(const Garment& g, const Points& x) {
   const std::size_t nv = g.vertex_count();
   constexpr std::size_t kGrain = 1 << 15;
   const auto blocks = [](std::size_t n) { return (n + kGrain - 1) / kGrain; };
@@ -487,7 +487,7 @@ Parts format_plain(const Garment& g) {
         for (std::size_t i = k * kGrain; i < std::min(nv, (k + 1) * kGrain); ++i) {
           const auto ii = static_cast<Eigen::Index>(i);
           out += "v ";
-          append_xyz(out, g.positions(ii, 0), g.positions(ii, 1), g.positions(ii, 2));
+          append_xyz(out, x(ii, 0), x(ii, 1), x(ii, 2));
           out.push_back('\n');
         }
       } else if (k < bv + bf) {
@@ -505,7 +505,7 @@ Parts format_plain(const Garment& g) {
 // Each referenced normal: the normalised sum of the area-weighted (Newell)
 // normals of the faces whose corners use it. Sequential scatter in face order,
 // so the sums are the same whatever the thread count.
-std::vector<std::uint8_t> recompute_normals(const Garment& g, const ObjSource& s, Points& normals,
+std::vector<std::uint8_t> recompute_normals(const Garment& g, const Points& x, const ObjSource& s, Points& normals,
                                             ObjWriteReport& report) {
   const std::size_t nn = static_cast<std::size_t>(s.normals.rows());
   std::vector<std::uint8_t> recomputed(nn, 0);
@@ -515,8 +515,8 @@ std::vector<std::uint8_t> recompute_normals(const Garment& g, const ObjSource& s
     const auto row = g.faces.row(f);
     Vec3 n = Vec3::Zero();
     for (std::size_t k = 0; k < row.size(); ++k) {
-      const Vec3 a = row3(g.positions, row[k]);
-      const Vec3 b = row3(g.positions, row[(k + 1) % row.size()]);
+      const Vec3 a = row3(x, row[k]);
+      const Vec3 b = row3(x, row[(k + 1) % row.size()]);
       n += a.cross(b);
     }
     for (std::size_t k = g.faces.offsets[f]; k < g.faces.offsets[f + 1]; ++k) {
@@ -544,7 +544,8 @@ std::vector<std::uint8_t> recompute_normals(const Garment& g, const ObjSource& s
   return recomputed;
 }
 
-Parts format_source(const Garment& g, const ObjSource& s, ObjWriteReport& report, const std::string& where) {
+Parts format_source(const Garment& g, const Points& x, const ObjSource& s, ObjWriteReport& report,
+                    const std::string& where) {
   if (g.vertex_count() != s.vertex_spans.size())
     throw input_error(where, "the garment has " + std::to_string(g.vertex_count()) + " vertices but its source " +
                                  s.file + " has " + std::to_string(s.vertex_spans.size()) +
@@ -559,13 +560,13 @@ Parts format_source(const Garment& g, const ObjSource& s, ObjWriteReport& report
   const std::size_t moved_count = deterministic_sum<std::size_t>(0, nv, 1 << 15, 0, [&](std::size_t i) -> std::size_t {
     const auto ii = static_cast<Eigen::Index>(i);
     bool m = false;
-    for (int k = 0; k < 3; ++k) m |= !same_bits(g.positions(ii, k), s.positions(ii, k));
+    for (int k = 0; k < 3; ++k) m |= !same_bits(x(ii, k), s.positions(ii, k));
     moved[i] = m;
     return m ? 1 : 0;
   });
   Points normals;
   std::vector<std::uint8_t> recomputed;
-  if (moved_count > 0 && !s.corner_normals.empty()) recomputed = recompute_normals(g, s, normals, report);
+  if (moved_count > 0 && !s.corner_normals.empty()) recomputed = recompute_normals(g, x, s, normals, report);
 
   const std::size_t nc = s.chunk_begin.size() - 1;
   std::vector<std::string> parts(nc);
@@ -582,7 +583,7 @@ Parts format_source(const Garment& g, const ObjSource& s, ObjWriteReport& report
         const std::size_t i = vertex ? vi++ : ni++;
         if (vertex ? !moved[i] : (recomputed.empty() || !recomputed[i])) continue;
         const ObjSource::Span sp = vertex ? s.vertex_spans[i] : s.normal_spans[i];
-        const Points& p = vertex ? g.positions : normals;
+        const Points& p = vertex ? x : normals;
         const auto ii = static_cast<Eigen::Index>(i);
         out.append(s.text, pos, sp.begin - pos);
         append_xyz(out, p(ii, 0), p(ii, 1), p(ii, 2));
@@ -594,9 +595,9 @@ Parts format_source(const Garment& g, const ObjSource& s, ObjWriteReport& report
   return parts;
 }
 
-Parts format_impl(const Garment& g, ObjWriteReport& report, const std::string& where) {
-  check_finite(g.positions, where);
-  return g.source ? format_source(g, *g.source, report, where) : format_plain(g);
+Parts format_impl(const Garment& g, const Points& x, ObjWriteReport& report, const std::string& where) {
+  check_finite(x, where);
+  return g.source ? format_source(g, x, *g.source, report, where) : format_plain(g, x);
 }
 
 }  // namespace
@@ -622,16 +623,20 @@ Garment read_garment_obj(const std::string& path) {
 
 std::string format_garment_obj(const Garment& g, ObjWriteReport* report) {
   ObjWriteReport local;
-  Parts parts = format_impl(g, report ? *report : local, g.source ? g.source->file : std::string("<garment>"));
+  Parts parts = format_impl(g, g.positions, report ? *report : local, g.source ? g.source->file : std::string("<garment>"));
   return join(parts);
 }
 
 ObjWriteReport write_garment_obj(const std::string& path, const Garment& g) {
+  return write_garment_obj(path, g, g.positions);
+}
+
+ObjWriteReport write_garment_obj(const std::string& path, const Garment& g, const Points& positions) {
+  if (positions.rows() != g.positions.rows())
+    throw input_error(path, "cannot write " + std::to_string(positions.rows()) + " positions for a garment of " +
+                                std::to_string(g.positions.rows()) + " vertices");
   ObjWriteReport report;
-  const Parts parts = format_impl(g, report, path);
-  write_file_atomically(path, [&](std::ostream& out) {
-    for (const std::string& p : parts) out.write(p.data(), static_cast<std::streamsize>(p.size()));
-  });
+  write_parts_atomically(path, format_impl(g, positions, report, path));
   return report;
 }
 

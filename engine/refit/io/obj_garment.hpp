@@ -67,6 +67,9 @@ struct ObjWriteReport {
 /// Throws refit::Error naming `path` on non-finite positions, a garment that no
 /// longer matches its source, or an I/O failure.
 ObjWriteReport write_garment_obj(const std::string& path, const Garment& g);
+/// The same for g's elements and source with other `positions` (same rows; a
+/// resize result), without copying the garment.
+ObjWriteReport write_garment_obj(const std::string& path, const Garment& g, const Points& positions);
 
 /// The OBJ text of `g`. With g.source: the source text where only the x y z of
 /// `v` lines change and each referenced `vn` becomes the normalised sum of the
