@@ -1,17 +1,78 @@
 #include <refit/core/error.hpp>
 #include <refit/io/atomic_file.hpp>
 
+#include <refit/core/parallel.hpp>
+
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <fcntl.h>
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
 
 namespace refit {
 
+namespace {
+
+std::filesystem::path temporary_for(const std::filesystem::path& target) {
+  return target.parent_path() / (target.filename().string() + ".tmp" + std::to_string(::getpid()));
+}
+
+void rename_or_throw(const std::filesystem::path& tmp, const std::filesystem::path& target, const std::string& path) {
+  std::error_code ec;
+  std::filesystem::rename(tmp, target, ec);
+  if (ec) throw input_error(path, "cannot rename temporary file: " + ec.message());
+}
+
+}  // namespace
+
+void write_parts_atomically(const std::string& path, const std::vector<std::string>& parts) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  const fs::path tmp = temporary_for(target);
+  std::vector<off_t> offset(parts.size() + 1, 0);
+  for (std::size_t i = 0; i < parts.size(); ++i) offset[i + 1] = offset[i] + static_cast<off_t>(parts[i].size());
+  int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw input_error(path, std::string("cannot open for writing: ") + std::strerror(errno));
+  try {
+    std::atomic<int> error{0};
+    parallel_for(0, parts.size(), 1, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e && error.load() == 0; ++i) {
+        const char* data = parts[i].data();
+        std::size_t left = parts[i].size();
+        off_t at = offset[i];
+        while (left > 0) {
+          const ssize_t n = ::pwrite(fd, data, left, at);
+          if (n < 0 && errno == EINTR) continue;
+          if (n <= 0) {
+            int expected = 0;
+            error.compare_exchange_strong(expected, n < 0 ? errno : EIO);
+            return;
+          }
+          data += n;
+          left -= static_cast<std::size_t>(n);
+          at += n;
+        }
+      }
+    });
+    if (error.load() != 0) throw input_error(path, std::string("write failed: ") + std::strerror(error.load()));
+    const int closed = ::close(fd);
+    fd = -1;
+    if (closed != 0) throw input_error(path, std::string("write failed: ") + std::strerror(errno));
+    rename_or_throw(tmp, target, path);
+  } catch (...) {
+    if (fd >= 0) ::close(fd);
+    std::error_code ignore;
+    fs::remove(tmp, ignore);
+    throw;
+  }
+}
+
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
   namespace fs = std::filesystem;
   const fs::path target(path);
-  const fs::path tmp = target.parent_path() /
-                       (target.filename().string() + ".tmp" + std::to_string(::getpid()));
+  const fs::path tmp = temporary_for(target);
   try {
     {
       std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
@@ -20,9 +81,7 @@ void write_file_atomically(const std::string& path, const std::function<void(std
       out.flush();
       if (!out) throw input_error(path, "write failed (disk full?)");
     }
-    std::error_code ec;
-    fs::rename(tmp, target, ec);
-    if (ec) throw input_error(path, "cannot rename temporary file: " + ec.message());
+    rename_or_throw(tmp, target, path);
   } catch (...) {
     std::error_code ignore;
     fs::remove(tmp, ignore);
