@@ -36,7 +36,7 @@ struct SurfaceOptions {
   std::size_t max_reach_agents = 8;   // a vertex blends its nearest agents (at most this many, within reach)
   bool keep_near_vertices = true;  // garment vertices closer than epsilon to body B keep their warped positions too
   int coarse_levels = 4;           // coarse-to-fine start: agent subsets with voxels 2, 4, ... times larger (see apply)
-  std::size_t coarse_min_agents = 500;   // no coarser level below this many agents
+  std::size_t coarse_min_agents = 50;    // no coarser level below this many agents
   bool multigrid = true;           // V-cycles with Galerkin coarse operators after the coarse-to-fine start (false: plain sweeps)
   int multigrid_sweeps = 2;        // Gauss-Seidel sweeps before and after each coarse correction
   int coarsest_sweeps = 50;        // sweeps of the coarsest correction
