@@ -53,6 +53,7 @@ int run(const ResizeArgs& a) {
     options.surface.smooth_blend = false;
     options.surface.emit_from_original = false;
     options.surface.smooth_passes = 0;
+    options.surface.keep_clear_of_body = false;
   }
   options.collision = !a.no_collision;
   options.metrics = a.metrics;

@@ -33,6 +33,8 @@ nlohmann::json surface_report(const SurfaceStats& s) {
           {"one_ring_degree_max", s.ring_degree_max},
           {"fixed_body", s.fixed_body},
           {"fixed_feature", s.fixed_feature},
+          {"fixed_clearance", s.fixed_clearance},
+          {"clearance_rounds", s.clearance_rounds},
           {"anchored", s.anchored},
           {"anchored_groups", s.anchored_groups},
           {"iterations", s.iterations},
@@ -89,6 +91,7 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
     SurfaceOptions so = options_.surface;
     so.epsilon *= per_cm;
     so.voxel *= per_cm;
+    so.clearance = 2.0 * options_.clearance_cm * per_cm;
     std::vector<const Points*> samples;
     if (features_)
       for (const FeatureCurve& c : features_->model.curves) samples.push_back(&c.samples);

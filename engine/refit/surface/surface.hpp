@@ -35,6 +35,11 @@ struct SurfaceOptions {
   double block_voxels = 8.0;       // solver blocks are at least this many voxels wide (and wider than any one-ring edge)
   std::size_t max_reach_agents = 8;   // a vertex blends its nearest agents (at most this many, within reach)
   bool keep_near_vertices = true;  // garment vertices closer than epsilon to body B keep their warped positions too
+  bool keep_clear_of_body = true;  // free agents the solve leaves closer than `clearance` to body B (or inside) are held
+                                   // at that clearance and the system is solved again (see apply; false: the paper)
+  double clearance = 0.4;          // garment units (the pipeline passes twice its collision clearance, so vertices
+                                   // blended between held agents stay out of the collision step's reach)
+  int clearance_rounds = 4;        // such re-solves, at most
   int coarse_levels = 4;           // coarse-to-fine start: agent subsets with voxels 2, 4, ... times larger (see apply)
   std::size_t coarse_min_agents = 50;    // no coarser level below this many agents
   bool multigrid = true;           // V-cycles with Galerkin coarse operators after the coarse-to-fine start (false: plain sweeps)
@@ -67,6 +72,8 @@ struct SurfaceStats {
   std::size_t blocks = 0, sequential_agents = 0;
   double block_width = 0.0;
   std::size_t fixed_body = 0, fixed_feature = 0;
+  std::size_t fixed_clearance = 0;  // agents the solve left closer than the clearance to body B, then held at it
+  int clearance_rounds = 0;         // re-solves after adding such agents
   std::size_t anchored = 0, anchored_groups = 0;  // agents (and their groups) with no fixed agent, held at their warped positions
   int iterations = 0;
   double final_update = 0.0;
@@ -105,8 +112,9 @@ class SurfaceBinding {
   ///
   /// Deforms the warped garment so that feature agents reach `feature_targets`
   /// (same rows as the bound feature samples, eq. 15), agents closer than epsilon to
-  /// body B keep their warped positions (eq. 14; `distance_to_body_b` is called
-  /// from several threads), the rest solve eq. 13, and every vertex is re-emitted
+  /// body B keep their warped positions (eq. 14; `distance_to_body_b` is the signed
+  /// distance, negative inside, and is called from several threads; it may stop
+  /// counting a little beyond epsilon), the rest solve eq. 13, and every vertex is re-emitted
   /// from the agents' frames (eq. 4). `feature_warped` gives the feature samples'
   /// warped positions (their "before" frames); when null, each sample moves with its
   /// nearest garment vertex. Throws refit::Error on size mismatches or non-finite input.

@@ -10,11 +10,15 @@ SurfaceResult SurfaceBinding::apply(const Points& warped_vertices, const Points&
                                     const BodySurface& body_b, const Points* feature_warped) const {
   // Only "closer than epsilon" matters, and (for apply's vertex test) a lower bound
   // a little beyond it: the bounded query stops early far from the body, and
-  // "farther than the bound" is reported as the bound itself.
+  // "farther than the bound" is reported as the bound itself. Inside is negative.
   const double bound = options_.epsilon + 2.0 * options_.reach_voxels * h_;
-  return apply(warped_vertices, feature_targets,
-               [&body_b, bound](const Vec3& p) { return std::min(body_b.closest_within(p, bound).distance, bound); },
-               feature_warped);
+  return apply(
+      warped_vertices, feature_targets,
+      [&body_b, bound](const Vec3& p) {
+        const double d = std::min(body_b.closest_within(p, bound).distance, bound);
+        return body_b.inside(p) ? -d : d;
+      },
+      feature_warped);
 }
 
 }  // namespace refit
