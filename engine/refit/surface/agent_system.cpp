@@ -187,6 +187,11 @@ bool BlockSchedule::concurrent(Index a, Index b) const {
   return ba != bb && block_colour[ba] == block_colour[bb];
 }
 
+namespace {
+// Below this many agents a sweep runs on the calling thread (see gauss_seidel).
+constexpr std::size_t kParallelSweepAgents = 8192;
+}  // namespace
+
 SolveReport gauss_seidel(const AgentRows& rows, const BlockSchedule& s, const std::vector<std::uint8_t>& free,
                          Points& x, const SolveOptions& options) {
   return gauss_seidel(rows, rows.h, s, free, x, options);
@@ -219,19 +224,29 @@ SolveReport gauss_seidel(const AgentRows& rows, const Points& hvec, const BlockS
     return dx * dx + dy * dy + dz * dz;
   };
   std::vector<double> block_change(s.blocks(), 0.0);
+  auto sweep_blocks = [&](const auto& blocks, std::size_t bb, std::size_t be) {
+    for (std::size_t k = bb; k < be; ++k) {
+      const Index b = blocks[k];
+      double change = 0.0;
+      for (std::size_t a = s.block_offsets[b]; a < s.block_offsets[b + 1]; ++a)
+        if (!s.sequential[a]) change += update(a);
+      block_change[b] = change;
+    }
+  };
+  // Blocks of one colour commute, so sweeping them in turn gives the same bits;
+  // small systems (the coarse levels of the multigrid cycles: a few hundred
+  // agents, dozens of sweeps per cycle) do, since handing 8 colours a sweep to
+  // the threads costs more than the sweep itself.
+  const bool in_turn = rows.size() < kParallelSweepAgents;
   SolveReport report;
   for (int it = 0; it < options.max_iterations; ++it) {
     for (std::size_t c = 0; c < s.colour_blocks.rows(); ++c) {
       auto blocks = s.colour_blocks.row(c);
-      parallel_for(0, blocks.size(), 1, [&](std::size_t bb, std::size_t be) {
-        for (std::size_t k = bb; k < be; ++k) {
-          const Index b = blocks[k];
-          double change = 0.0;
-          for (std::size_t a = s.block_offsets[b]; a < s.block_offsets[b + 1]; ++a)
-            if (!s.sequential[a]) change += update(a);
-          block_change[b] = change;
-        }
-      });
+      if (in_turn) {
+        sweep_blocks(blocks, 0, blocks.size());
+      } else {
+        parallel_for(0, blocks.size(), 1, [&](std::size_t bb, std::size_t be) { sweep_blocks(blocks, bb, be); });
+      }
     }
     double total = 0.0;
     for (double c : block_change) total += c;
