@@ -2,6 +2,10 @@
 // triangles and ray hits; every distance and every inside/outside decision near
 // the surface is made in double on the body's own positions.
 #include <refit/body/body_surface.hpp>
+
+#include <refit/core/parallel.hpp>
+
+#include <tbb/task_arena.h>
 #include <refit/body/embree_ray.hpp>
 #include <refit/core/error.hpp>
 
@@ -280,28 +284,43 @@ struct BodySurface::Impl {
     }
     // Flood fill each region of free cells (6-connected); a region touches no
     // triangle, so one vote at any of its cells is the answer for all of them.
-    std::vector<long> queue;
-    for (long start = 0; start < static_cast<long>(grid.size()); ++start) {
-      if (grid[static_cast<std::size_t>(start)] != 255) continue;
-      const long sx = start % grid_n[0], sy = (start / grid_n[0]) % grid_n[1], sz = start / (grid_n[0] * grid_n[1]);
-      const Vec3 centre = grid_lo + grid_h * Vec3(sx + 0.5, sy + 0.5, sz + 0.5);
-      const std::uint8_t label = inside_by_rays(centre) ? kInside : kOutside;
-      queue.assign(1, start);
-      grid[static_cast<std::size_t>(start)] = label;
-      while (!queue.empty()) {
-        const long c = queue.back();
-        queue.pop_back();
-        const long x = c % grid_n[0], y = (c / grid_n[0]) % grid_n[1], z = c / (grid_n[0] * grid_n[1]);
-        const long nb[6][3] = {{x - 1, y, z}, {x + 1, y, z}, {x, y - 1, z}, {x, y + 1, z}, {x, y, z - 1}, {x, y, z + 1}};
-        for (const auto& q : nb) {
-          if (q[0] < 0 || q[1] < 0 || q[2] < 0 || q[0] >= grid_n[0] || q[1] >= grid_n[1] || q[2] >= grid_n[2]) continue;
-          const long qi = cell_index(q[0], q[1], q[2]);
-          if (grid[static_cast<std::size_t>(qi)] != 255) continue;
-          grid[static_cast<std::size_t>(qi)] = label;
-          queue.push_back(qi);
+    // In fixed slabs of z, in parallel: a region cut by slab borders gets one
+    // vote per piece (the same answer), and the labels do not depend on the
+    // thread count. Isolated: this runs inside call_once, often from a parallel
+    // loop; a thread waiting here must not pick up that loop's tasks (they would
+    // enter call_once again and deadlock).
+    constexpr long kSlabs = 16;
+    const long plane = grid_n[0] * grid_n[1];
+    auto fill_slab = [&](long slab, std::vector<long>& queue) {
+      const long z0 = grid_n[2] * slab / kSlabs, z1 = grid_n[2] * (slab + 1) / kSlabs;
+      for (long start = z0 * plane; start < z1 * plane; ++start) {
+        if (grid[static_cast<std::size_t>(start)] != 255) continue;
+        const long sx = start % grid_n[0], sy = (start / grid_n[0]) % grid_n[1], sz = start / plane;
+        const Vec3 centre = grid_lo + grid_h * Vec3(sx + 0.5, sy + 0.5, sz + 0.5);
+        const std::uint8_t label = inside_by_rays(centre) ? kInside : kOutside;
+        queue.assign(1, start);
+        grid[static_cast<std::size_t>(start)] = label;
+        while (!queue.empty()) {
+          const long c = queue.back();
+          queue.pop_back();
+          const long x = c % grid_n[0], y = (c / grid_n[0]) % grid_n[1], z = c / plane;
+          const long nb[6][3] = {{x - 1, y, z}, {x + 1, y, z}, {x, y - 1, z}, {x, y + 1, z}, {x, y, z - 1}, {x, y, z + 1}};
+          for (const auto& q : nb) {
+            if (q[0] < 0 || q[1] < 0 || q[2] < z0 || q[0] >= grid_n[0] || q[1] >= grid_n[1] || q[2] >= z1) continue;
+            const long qi = cell_index(q[0], q[1], q[2]);
+            if (grid[static_cast<std::size_t>(qi)] != 255) continue;
+            grid[static_cast<std::size_t>(qi)] = label;
+            queue.push_back(qi);
+          }
         }
       }
-    }
+    };
+    tbb::this_task_arena::isolate([&] {
+      parallel_for(0, kSlabs, 1, [&](std::size_t b, std::size_t e) {
+        std::vector<long> queue;
+        for (std::size_t slab = b; slab < e; ++slab) fill_slab(long(slab), queue);
+      });
+    });
   }
 
   // kInside / kOutside when the grid knows, kBoundary when the point needs a query.
