@@ -15,7 +15,7 @@ class Error : public std::runtime_error {
 /// "file: problem" or "file:line: problem".
 inline Error input_error(const std::string& file, const std::string& problem, std::size_t line = 0) {
   std::string where = file.empty() ? std::string("<input>") : file;
-  if (line > 0) where += ":" + std::to_string(line);
+  if (line > 0) (where += ':') += std::to_string(line);  // not ":" + string: GCC 12's false -Wrestrict (bug 105329)
   return Error(where + ": " + problem);
 }
 
