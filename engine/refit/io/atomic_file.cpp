@@ -3,6 +3,7 @@
 
 #include <refit/core/parallel.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstring>
@@ -27,36 +28,50 @@ void rename_or_throw(const std::filesystem::path& tmp, const std::filesystem::pa
 
 }  // namespace
 
-void write_parts_atomically(const std::string& path, const std::vector<std::string>& parts) {
+void write_parts_atomically(const std::string& path, std::size_t count, const PartFormatter& format) {
   namespace fs = std::filesystem;
   const fs::path target(path);
   const fs::path tmp = temporary_for(target);
-  std::vector<off_t> offset(parts.size() + 1, 0);
-  for (std::size_t i = 0; i < parts.size(); ++i) offset[i + 1] = offset[i] + static_cast<off_t>(parts[i].size());
   int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw input_error(path, std::string("cannot open for writing: ") + std::strerror(errno));
   try {
+    // 64 parts of a few hundred kB: enough work per batch for the threads, and
+    // buffers small enough that reusing them costs no fresh pages.
+    constexpr std::size_t kBatch = 64;
+    std::vector<std::string> buffer(std::min(count, kBatch));
+    std::vector<off_t> offset(buffer.size() + 1, 0);
     std::atomic<int> error{0};
-    parallel_for(0, parts.size(), 1, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e && error.load() == 0; ++i) {
-        const char* data = parts[i].data();
-        std::size_t left = parts[i].size();
-        off_t at = offset[i];
-        while (left > 0) {
-          const ssize_t n = ::pwrite(fd, data, left, at);
-          if (n < 0 && errno == EINTR) continue;
-          if (n <= 0) {
-            int expected = 0;
-            error.compare_exchange_strong(expected, n < 0 ? errno : EIO);
-            return;
-          }
-          data += n;
-          left -= static_cast<std::size_t>(n);
-          at += n;
+    for (std::size_t first = 0; first < count; first += kBatch) {
+      const std::size_t m = std::min(kBatch, count - first);
+      parallel_for(0, m, 1, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+          buffer[i].clear();
+          format(first + i, buffer[i]);
         }
-      }
-    });
-    if (error.load() != 0) throw input_error(path, std::string("write failed: ") + std::strerror(error.load()));
+      });
+      for (std::size_t i = 0; i < m; ++i) offset[i + 1] = offset[i] + static_cast<off_t>(buffer[i].size());
+      parallel_for(0, m, 1, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e && error.load() == 0; ++i) {
+          const char* data = buffer[i].data();
+          std::size_t left = buffer[i].size();
+          off_t at = offset[i];
+          while (left > 0) {
+            const ssize_t n = ::pwrite(fd, data, left, at);
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0) {
+              int expected = 0;
+              error.compare_exchange_strong(expected, n < 0 ? errno : EIO);
+              return;
+            }
+            data += n;
+            left -= static_cast<std::size_t>(n);
+            at += n;
+          }
+        }
+      });
+      if (error.load() != 0) throw input_error(path, std::string("write failed: ") + std::strerror(error.load()));
+      offset[0] = offset[m];
+    }
     const int closed = ::close(fd);
     fd = -1;
     if (closed != 0) throw input_error(path, std::string("write failed: ") + std::strerror(errno));

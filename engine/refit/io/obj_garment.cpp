@@ -447,21 +447,28 @@ void check_finite(const Points& p, const std::string& where) {
     if (i < n) throw input_error(where, "vertex " + std::to_string(i + 1) + " has a non-finite coordinate; nothing written");
 }
 
-std::string join(std::vector<std::string>& parts) {
+// The output in parts (one per chunk of the source, or per block of elements),
+// each formatted on demand: a writer streams them without the whole file in memory.
+struct Parts {
+  std::size_t count = 0;
+  PartFormatter format;
+};
+
+std::string join(const Parts& parts) {
+  std::vector<std::string> text(parts.count);
+  parallel_for(0, parts.count, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) parts.format(k, text[k]);
+  });
   std::size_t total = 0;
-  for (const auto& s : parts) total += s.size();
+  for (const auto& t : text) total += t.size();
   std::string out;
   out.reserve(total);
-  for (auto& s : parts) {
-    out += s;
-    std::string().swap(s);
+  for (auto& t : text) {
+    out += t;
+    std::string().swap(t);
   }
   return out;
 }
-
-// The output comes in parts (one per chunk), so a writer can stream them
-// without first joining them into one more copy of the file.
-using Parts = std::vector<std::string>;
 
 // A plain OBJ for garments that come from no file.
 Parts format_plain(const Garment& g, const Points& x) {
@@ -469,8 +476,7 @@ Parts format_plain(const Garment& g, const Points& x) {
   constexpr std::size_t kGrain = 1 << 15;
   const auto blocks = [](std::size_t n) { return (n + kGrain - 1) / kGrain; };
   const std::size_t bv = blocks(nv), bf = blocks(g.faces.rows()), bl = blocks(g.lines.rows()), bp = blocks(g.points.rows());
-  std::vector<std::string> parts(bv + bf + bl + bp);
-  const auto csr_part = [&](const Csr& csr, const char* kw, std::size_t k, std::string& out) {
+  const auto csr_part = [](const Csr& csr, const char* kw, std::size_t k, std::string& out) {
     for (std::size_t r = k * kGrain; r < std::min(csr.rows(), (k + 1) * kGrain); ++r) {
       out += kw;
       for (Index i : csr.row(r)) {
@@ -480,26 +486,22 @@ Parts format_plain(const Garment& g, const Points& x) {
       out.push_back('\n');
     }
   };
-  parallel_for(0, parts.size(), 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t k = b; k < e; ++k) {
-      std::string& out = parts[k];
-      if (k < bv) {
-        for (std::size_t i = k * kGrain; i < std::min(nv, (k + 1) * kGrain); ++i) {
-          const auto ii = static_cast<Eigen::Index>(i);
-          out += "v ";
-          append_xyz(out, x(ii, 0), x(ii, 1), x(ii, 2));
-          out.push_back('\n');
-        }
-      } else if (k < bv + bf) {
-        csr_part(g.faces, "f", k - bv, out);
-      } else if (k < bv + bf + bl) {
-        csr_part(g.lines, "l", k - bv - bf, out);
-      } else {
-        csr_part(g.points, "p", k - bv - bf - bl, out);
-      }
-    }
-  });
-  return parts;
+  return {bv + bf + bl + bp, [&g, &x, nv, bv, bf, bl, csr_part](std::size_t k, std::string& out) {
+            if (k < bv) {
+              for (std::size_t i = k * kGrain; i < std::min(nv, (k + 1) * kGrain); ++i) {
+                const auto ii = static_cast<Eigen::Index>(i);
+                out += "v ";
+                append_xyz(out, x(ii, 0), x(ii, 1), x(ii, 2));
+                out.push_back('\n');
+              }
+            } else if (k < bv + bf) {
+              csr_part(g.faces, "f", k - bv, out);
+            } else if (k < bv + bf + bl) {
+              csr_part(g.lines, "l", k - bv - bf, out);
+            } else {
+              csr_part(g.points, "p", k - bv - bf - bl, out);
+            }
+          }};
 }
 
 // Each referenced normal: the normalised sum of the area-weighted (Newell)
@@ -568,31 +570,31 @@ Parts format_source(const Garment& g, const Points& x, const ObjSource& s, ObjWr
   std::vector<std::uint8_t> recomputed;
   if (moved_count > 0 && !s.corner_normals.empty()) recomputed = recompute_normals(g, x, s, normals, report);
 
-  const std::size_t nc = s.chunk_begin.size() - 1;
-  std::vector<std::string> parts(nc);
-  parallel_for(0, nc, 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t c = b; c < e; ++c) {
-      std::string& out = parts[c];
-      std::size_t pos = s.chunk_begin[c];
-      const std::size_t end = s.chunk_begin[c + 1];
-      out.reserve(end - pos + (end - pos) / 4);
-      std::size_t vi = s.chunk_first_vertex[c], ni = s.chunk_first_normal[c];
-      const std::size_t vend = s.chunk_first_vertex[c + 1], nend = s.chunk_first_normal[c + 1];
-      while (vi < vend || ni < nend) {
-        const bool vertex = ni >= nend || (vi < vend && s.vertex_spans[vi].begin < s.normal_spans[ni].begin);
-        const std::size_t i = vertex ? vi++ : ni++;
-        if (vertex ? !moved[i] : (recomputed.empty() || !recomputed[i])) continue;
-        const ObjSource::Span sp = vertex ? s.vertex_spans[i] : s.normal_spans[i];
-        const Points& p = vertex ? x : normals;
-        const auto ii = static_cast<Eigen::Index>(i);
-        out.append(s.text, pos, sp.begin - pos);
-        append_xyz(out, p(ii, 0), p(ii, 1), p(ii, 2));
-        pos = sp.end;
-      }
-      out.append(s.text, pos, end - pos);
-    }
-  });
-  return parts;
+  // Shared by the copies of the formatter (std::function copies what it holds).
+  struct Edits {
+    std::vector<std::uint8_t> moved, recomputed;
+    Points normals;
+  };
+  auto edits = std::make_shared<Edits>(Edits{std::move(moved), std::move(recomputed), std::move(normals)});
+  return {s.chunk_begin.size() - 1, [&x, &s, edits](std::size_t c, std::string& out) {
+            std::size_t pos = s.chunk_begin[c];
+            const std::size_t end = s.chunk_begin[c + 1];
+            out.reserve(end - pos + (end - pos) / 4);
+            std::size_t vi = s.chunk_first_vertex[c], ni = s.chunk_first_normal[c];
+            const std::size_t vend = s.chunk_first_vertex[c + 1], nend = s.chunk_first_normal[c + 1];
+            while (vi < vend || ni < nend) {
+              const bool vertex = ni >= nend || (vi < vend && s.vertex_spans[vi].begin < s.normal_spans[ni].begin);
+              const std::size_t i = vertex ? vi++ : ni++;
+              if (vertex ? !edits->moved[i] : (edits->recomputed.empty() || !edits->recomputed[i])) continue;
+              const ObjSource::Span sp = vertex ? s.vertex_spans[i] : s.normal_spans[i];
+              const Points& p = vertex ? x : edits->normals;
+              const auto ii = static_cast<Eigen::Index>(i);
+              out.append(s.text, pos, sp.begin - pos);
+              append_xyz(out, p(ii, 0), p(ii, 1), p(ii, 2));
+              pos = sp.end;
+            }
+            out.append(s.text, pos, end - pos);
+          }};
 }
 
 Parts format_impl(const Garment& g, const Points& x, ObjWriteReport& report, const std::string& where) {
@@ -623,8 +625,7 @@ Garment read_garment_obj(const std::string& path) {
 
 std::string format_garment_obj(const Garment& g, ObjWriteReport* report) {
   ObjWriteReport local;
-  Parts parts = format_impl(g, g.positions, report ? *report : local, g.source ? g.source->file : std::string("<garment>"));
-  return join(parts);
+  return join(format_impl(g, g.positions, report ? *report : local, g.source ? g.source->file : std::string("<garment>")));
 }
 
 ObjWriteReport write_garment_obj(const std::string& path, const Garment& g) {
@@ -636,7 +637,8 @@ ObjWriteReport write_garment_obj(const std::string& path, const Garment& g, cons
     throw input_error(path, "cannot write " + std::to_string(positions.rows()) + " positions for a garment of " +
                                 std::to_string(g.positions.rows()) + " vertices");
   ObjWriteReport report;
-  write_parts_atomically(path, format_impl(g, positions, report, path));
+  const Parts parts = format_impl(g, positions, report, path);
+  write_parts_atomically(path, parts.count, parts.format);
   return report;
 }
 
