@@ -324,8 +324,12 @@ struct BodySurface::Impl {
   }
 
   // kInside / kOutside when the grid knows, kBoundary when the point needs a query.
-  std::uint8_t grid_label(const Vec3& p) const {
+  void ensure_grid() const {
     std::call_once(grid_once, [this] { build_grid(); });
+  }
+
+  std::uint8_t grid_label(const Vec3& p) const {
+    ensure_grid();
     long c[3];
     for (int k = 0; k < 3; ++k) {
       const double f = std::floor((p[k] - grid_lo[k]) / grid_h);
@@ -493,6 +497,8 @@ ClosestPoint BodySurface::closest_within(const Vec3& p, double max_distance) con
   r.triangle = d.tri;
   return r;
 }
+
+void BodySurface::prepare_inside_test() const { impl_->ensure_grid(); }
 
 bool BodySurface::inside(const Vec3& p) const {
   if (!p.allFinite()) return false;

@@ -29,6 +29,10 @@ class BodySurface {
   ClosestPoint closest_within(const Vec3& p, double max_distance) const;
   /// True when p is inside the closed body (ray parity, majority over several directions).
   bool inside(const Vec3& p) const;
+  /// Builds the inside test's lookup grid now; otherwise the first inside() call
+  /// builds it. Call it before a parallel loop of inside() tests: built from
+  /// within one, the other threads wait for it and it runs on one thread.
+  void prepare_inside_test() const;
   /// Negative inside, positive outside.
   double signed_distance(const Vec3& p) const;
   /// Ray cast: distance along unit dir to the first hit, +inf if none; tri_out gets the triangle.

@@ -111,23 +111,10 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   std::vector<std::uint8_t> is_touched(n, 0);
   std::vector<Vec3> first_position;  // aligned with `touched`: where each started
 
-  // The adjacency is built while the body readies its inside test (its first
-  // call builds a lookup grid, a serial step): at two threads or more both
-  // are done at once. Bit-identical either way; neither depends on the other.
-  Csr adj;
-  parallel_for(0, 2, 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t task = b; task < e; ++task) {
-      if (task == 1) {
-        adj = vertex_adjacency(g);
-        continue;
-      }
-      for (std::size_t i = 0; i < n; ++i)
-        if (finite[i]) {
-          body_b.inside(row3(positions, static_cast<Index>(i)));
-          break;
-        }
-    }
-  });
+  // The inside test's grid, built in parallel here rather than on the first
+  // inside() call of the parallel loop below (there it would run on one thread).
+  body_b.prepare_inside_test();
+  const Csr adj = vertex_adjacency(g);
 
   for (int round = 0; round < std::max(1, options.max_rounds); ++round) {
     // 1. Which vertices are inside or too close, and where they must go: fixed

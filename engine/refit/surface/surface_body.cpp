@@ -12,6 +12,7 @@ SurfaceResult SurfaceBinding::apply(const Points& warped_vertices, const Points&
   // a little beyond it: the bounded query stops early far from the body, and
   // "farther than the bound" is reported as the bound itself. Inside is negative.
   const double bound = options_.epsilon + 2.0 * options_.reach_voxels * h_;
+  body_b.prepare_inside_test();  // apply's first distances come from a parallel loop
   return apply(
       warped_vertices, feature_targets,
       [&body_b, bound](const Vec3& p) {
