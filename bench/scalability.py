@@ -5,6 +5,9 @@ report's stage timings (ms) and peak memory, median of --repeat runs.
 
     python3 bench/scalability.py [--refit build/release/tools/refit]
         [--sizes 100000 1000000 4000000] [--threads 1 2] [--stage warp|full] [--repeat 3]
+
+Runs alternate between the thread counts. After each size's rows, the ratio of
+the first thread count's median total to each other's.
 """
 import argparse
 import json
@@ -37,20 +40,26 @@ def main():
     print(f"stage: {a.stage}; medians of {a.repeat} runs; ms except memory")
     print("| vertices | threads | " + " | ".join(stages) + " | peak MB | bytes/vertex |")
     print("|" + "---:|" * (len(stages) + 4))
+    ratios = []
     for n in a.sizes:
         g = os.path.join(work, f"dress_{n}.obj")
         f = os.path.join(work, f"dress_{n}.json")
-        run([a.refit, "generate", "--vertices", str(n), "--garment-out", g, "--features-out", f])
-        for t in a.threads:
-            rows = []
-            for _ in range(a.repeat):
+        if not (os.path.exists(g) and os.path.exists(f)):  # a --workdir kept from an earlier run has them
+            run([a.refit, "generate", "--vertices", str(n), "--garment-out", g, "--features-out", f])
+        # Thread counts take turns run by run, so a slow spell of the shared
+        # machine hits them alike and their ratio stays meaningful.
+        reports = {t: [] for t in a.threads}
+        for _ in range(a.repeat):
+            for t in a.threads:
                 rep = os.path.join(work, "report.json")
                 cmd = [a.refit, "resize", "--garment", g, "--from", A, "--to", B, "--out", os.path.join(work, "out.obj"),
                        "--report", rep, "--threads", str(t), "--quiet", "--stage", a.stage]
                 if a.stage != "warp":
                     cmd += ["--features", f]
                 run(cmd)
-                rows.append(json.load(open(rep)))
+                reports[t].append(json.load(open(rep)))
+        for t in a.threads:
+            rows = reports[t]
             def med(key):
                 vals = []
                 for r in rows:
@@ -61,6 +70,15 @@ def main():
             mem = statistics.median(r["peak_memory_mb"] for r in rows)
             cells = " | ".join(f"{med(s):.0f}" for s in stages)
             print(f"| {verts} | {t} | {cells} | {mem:.0f} | {mem * 1048576 / verts:.0f} |", flush=True)
+            totals = [r["timings_ms"]["total"] for r in rows]
+            if t == a.threads[0]:
+                base = statistics.median(totals)
+            else:
+                ratios.append(f"{verts} vertices, {a.threads[0]} -> {t} threads: {base / statistics.median(totals):.2f}x "
+                              f"(totals ms: {', '.join(f'{v:.0f}' for v in totals)})")
+    print()
+    for line in ratios:
+        print(line)
 
 
 if __name__ == "__main__":
