@@ -5,6 +5,7 @@
 #include <refit/io/atomic_file.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cerrno>
 #include <charconv>
@@ -14,7 +15,9 @@
 #include <optional>
 #include <utility>
 
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 namespace refit {
 namespace {
@@ -102,7 +105,7 @@ struct Sink {
 
 class ChunkParser {
  public:
-  ChunkParser(const std::string& text, Chunk& out, const Sink& sink, Totals before, Totals totals)
+  ChunkParser(std::string_view text, Chunk& out, const Sink& sink, Totals before, Totals totals)
       : text_(text), out_(out), sink_(sink), cur_(before), totals_(totals) {}
 
   void parse(std::size_t begin, std::size_t end) {
@@ -275,7 +278,7 @@ class ChunkParser {
     }
   }
 
-  const std::string& text_;
+  std::string_view text_;
   Chunk& out_;
   const Sink& sink_;
   Totals cur_, totals_;
@@ -284,7 +287,7 @@ class ChunkParser {
 
 // Pass 1: lines and v/vt/vn counts of a chunk, so that pass 2 knows every
 // chunk's starting counts and can resolve relative indices and ranges at once.
-void count_chunk(const std::string& text, std::size_t begin, std::size_t end, Chunk& c) {
+void count_chunk(std::string_view text, std::size_t begin, std::size_t end, Chunk& c) {
   for_each_line(text.data() + begin, text.data() + end, [&](const char* b, const char* e) {
     ++c.lines;
     while (b < e && is_blank(*b)) ++b;
@@ -323,7 +326,8 @@ void fill_csr(Csr& csr, std::vector<Chunk>& chunks, std::vector<Index> Chunk::*s
   });
 }
 
-Garment parse_owned(std::string text, const std::string& file) {
+Garment parse_owned(TextBytes bytes, const std::string& file) {
+  const std::string_view text = bytes.view();
   const std::size_t n = text.size();
   auto src = std::make_shared<ObjSource>();
   src->file = file;
@@ -397,9 +401,9 @@ Garment parse_owned(std::string text, const std::string& file) {
     src->warnings.push_back(file + ": " + std::to_string(unknown - src->warnings.size()) +
                             " more unknown statements kept verbatim");
   const std::size_t first_nl = text.find('\n');
-  src->crlf = first_nl != std::string::npos && first_nl > 0 && text[first_nl - 1] == '\r';
+  src->crlf = first_nl != std::string_view::npos && first_nl > 0 && text[first_nl - 1] == '\r';
   chunks.clear();
-  src->text = std::move(text);
+  src->text = std::move(bytes);
   g.source = std::move(src);
   return g;
 }
@@ -589,11 +593,11 @@ Parts format_source(const Garment& g, const Points& x, const ObjSource& s, ObjWr
               const ObjSource::Span sp = vertex ? s.vertex_spans[i] : s.normal_spans[i];
               const Points& p = vertex ? x : edits->normals;
               const auto ii = static_cast<Eigen::Index>(i);
-              out.append(s.text, pos, sp.begin - pos);
+              out.append(s.text.view().substr(pos, sp.begin - pos));
               append_xyz(out, p(ii, 0), p(ii, 1), p(ii, 2));
               pos = sp.end;
             }
-            out.append(s.text, pos, end - pos);
+            out.append(s.text.view().substr(pos, end - pos));
           }};
 }
 
@@ -605,22 +609,42 @@ Parts format_impl(const Garment& g, const Points& x, ObjWriteReport& report, con
 }  // namespace
 
 Garment parse_garment_obj(std::string_view text, const std::string& file_for_errors) {
-  return parse_owned(std::string(text), file_for_errors);
+  return parse_owned(TextBytes(text), file_for_errors);
 }
 
 Garment read_garment_obj(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) throw input_error(path, std::string("cannot open: ") + std::strerror(errno));
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw input_error(path, std::string("cannot open: ") + std::strerror(errno));
   struct stat st {};
-  if (::fstat(::fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
-    std::fclose(f);
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
     throw input_error(path, "cannot read: not a regular file");
   }
-  std::string text(static_cast<std::size_t>(st.st_size), '\0');
-  const bool ok = std::fread(text.data(), 1, text.size(), f) == text.size();
-  std::fclose(f);
-  if (!ok) throw input_error(path, "cannot read the whole file");
-  return parse_owned(std::move(text), path);
+  // Ranges of the file read by several threads at once: the kernel's copy and the
+  // first touch of the buffer's pages were most of a large garment's read time.
+  TextBytes bytes(static_cast<std::size_t>(st.st_size));
+  constexpr std::size_t kRange = std::size_t(1) << 23;
+  std::atomic<int> error{0};  // errno of the first failure, or -1 when the file ended early
+  parallel_for(0, (bytes.size() + kRange - 1) / kRange, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t r = b; r < e && error.load() == 0; ++r) {
+      std::size_t at = r * kRange;
+      const std::size_t end = std::min(bytes.size(), at + kRange);
+      while (at < end) {
+        const ssize_t got = ::pread(fd, bytes.data() + at, end - at, static_cast<off_t>(at));
+        if (got < 0 && errno == EINTR) continue;
+        if (got <= 0) {
+          int expected = 0;
+          error.compare_exchange_strong(expected, got < 0 ? errno : -1);
+          return;
+        }
+        at += static_cast<std::size_t>(got);
+      }
+    }
+  });
+  ::close(fd);
+  if (error.load() > 0) throw input_error(path, std::string("cannot read: ") + std::strerror(error.load()));
+  if (error.load() < 0) throw input_error(path, "cannot read the whole file (it got shorter while being read)");
+  return parse_owned(std::move(bytes), path);
 }
 
 std::string format_garment_obj(const Garment& g, ObjWriteReport* report) {
