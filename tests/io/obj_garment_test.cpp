@@ -22,7 +22,7 @@ namespace {
 using ::testing::HasSubstr;
 using ::testing::StartsWith;
 
-std::vector<Index> all(const Csr& c) { return c.indices; }
+std::vector<Index> all(const Csr& c) { return {c.indices.begin(), c.indices.end()}; }
 std::vector<Index> offsets(const Csr& c) { return c.offsets; }
 
 std::vector<std::string> split(const std::string& text, const std::string& sep) {

@@ -282,8 +282,8 @@ SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, co
     const double reach2 = std::pow(options.reach_voxels * s.h_, 2);
     std::vector<std::uint8_t> capped(nv, 0);
     std::vector<std::uint8_t> count(nv, 0);
-    std::vector<Index> idx_all(nv * kmax);
-    std::vector<float> w_all(options.smooth_blend ? nv * kmax : 0);
+    UninitVector<Index> idx_all(nv * kmax);  // slots past a vertex's count stay unset and unread
+    UninitVector<float> w_all(options.smooth_blend ? nv * kmax : 0);
     parallel_for(0, nv, 2048, [&](std::size_t b, std::size_t e) {
       std::vector<Index> idx;
       std::vector<double> d2;
