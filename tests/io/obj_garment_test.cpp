@@ -381,6 +381,26 @@ TEST(ObjRead, ChunkedParseIsIndependentOfThreads) {
   EXPECT_EQ(format_garment_obj(ref), absolute);
 }
 
+TEST(ObjRead, AFileOfSeveralReadRangesIsReadByteForByte) {
+  // read_garment_obj reads 8 MB ranges on several threads: a 20 MB file spans three.
+  std::string text = "# big\n";
+  for (int i = 0; text.size() < (std::size_t(20) << 20); ++i) text += "v " + std::to_string(i) + " 0.5 -1.25\n";
+  text += "p 1 2 3\n";
+  test::TempDir dir;
+  const std::string path = dir.file("big.obj");
+  test::write_text(path, text);
+  const Garment parsed = parse_garment_obj(text, "big.obj");
+  for (int threads : {1, 2}) {
+    ThreadLimit limit(threads);
+    const Garment g = read_garment_obj(path);
+    ASSERT_TRUE(g.source);
+    EXPECT_TRUE(g.source->text.view() == text) << threads;
+    EXPECT_TRUE((g.positions.array() == parsed.positions.array()).all()) << threads;
+    EXPECT_EQ(write_garment_obj(dir.file("back.obj"), g).warnings.size(), 0u);
+    EXPECT_TRUE(test::read_text(dir.file("back.obj")) == text) << threads;
+  }
+}
+
 TEST(ObjRead, ErrorLineIsRightInALaterChunk) {
   const std::string text = strip_obj(12000, true, 20001);
   try {
