@@ -137,6 +137,35 @@ TEST(ShapeMatching, Fig5CrossingCurvesDependOnOrderAndShareTheCrossing) {
   for (const CurveResult* c : {&a1, &b2, &b1, &a2}) EXPECT_LT(c->shape_error_result, c->shape_error_warped) << c->name;
 }
 
+TEST(ShapeMatching, ACrossingOffTheLaterCurvesPlaneMovesThePlaneNotOneSample) {
+  // B crosses A; the warp moves A 0.8 along B's plane normal and leaves B alone, so
+  // the crossing A puts on B lies 0.8 off B's new (PCA) plane. B keeps its shape
+  // exactly by moving its plane there; fixing that one sample off the plane instead
+  // kinks B (shape error 0.0059).
+  Points a(41, 3), b(37, 3);
+  for (int i = 0; i < 41; ++i) a.row(i) << -10 + 0.5 * i, 1.5 * std::sin(0.25 * (-10 + 0.5 * i)), 0.0;
+  const double ya = 1.5 * std::sin(0.25 * 0.3);
+  for (int i = 0; i < 37; ++i) {
+    const double y = -9 + 0.5 * i;
+    b.row(i) << 0.3, y, 2.0 * std::sin(0.4 * (y - ya));
+  }
+  const FeatureCurve ca = make_feature_curve("A", a, false, plane_z0(), {}, 0);
+  const FeatureCurve cb =
+      make_feature_curve("B", b, false, FeaturePlane::from_point_normal(Vec3(0.3, 0, 0), Vec3::UnitX()), {}, 1);
+  const ShapeModel model = prepare_shape_model({ca, cb});
+  ASSERT_EQ(model.crossings[1].size(), 1u);
+  const Vec3 shift(0.8, 0.0, 0.0);
+  const FeatureResult r = match_shapes(model, {a.rowwise() + shift.transpose(), b},
+                                       {ca.aux.rowwise() + shift.transpose(), cb.aux},
+                                       [](const Vec3& p) { return std::abs(p.y() + 12.0) + 0.1 * std::abs(p.x()); });
+  const CurveResult& rb = r.curves[1];
+  ASSERT_EQ(rb.crossings.size(), 1u);
+  EXPECT_LT(nearest_on_polyline(r.curves[0].optimised, false, row3(rb.optimised, rb.crossings[0].index)).distance, 1e-9);
+  for (Eigen::Index i = 0; i < rb.optimised.rows(); ++i)
+    EXPECT_NEAR(rb.plane.signed_distance(row3(rb.optimised, Index(i))), 0.0, 1e-9) << i;
+  EXPECT_LT(rb.shape_error_result, 1e-5);  // 1.3e-6: the crossing sample moves onto A
+}
+
 TEST(ShapeMatching, ClosedHemLoopStaysClosed) {
   const std::size_t m = 60;
   Points s(m, 3);

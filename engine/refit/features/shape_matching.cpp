@@ -206,6 +206,18 @@ FeatureResult match_shapes(const ShapeModel& model, const std::vector<Points>& w
     r.original = c.samples;
     r.warped = ws;
     r.plane = new_plane(c, ws, wa);
+    // Crossings are fixed where the earlier curves put them, in 3D. The plane moves
+    // along its normal to pass through them (their mean offset): a crossing off the
+    // plane is one sample out of the curve's plane, a kink the in-plane shape
+    // matching cannot see. Measured on the real dress: the side profiles' hem
+    // crossing sat off their planes and kept them 2-12x below the warp's shape
+    // error instead of thousands of times.
+    if (!model.crossings[k].empty()) {
+      double offset = 0.0;
+      for (const Crossing& x : model.crossings[k])
+        offset += r.plane.signed_distance(point_on(result.curves[x.earlier].optimised, x.segment, x.t));
+      r.plane.point += (offset / static_cast<double>(model.crossings[k].size())) * r.plane.normal;
+    }
     Coords xw(static_cast<Eigen::Index>(m), 2);
     for (std::size_t i = 0; i < m; ++i) xw.row(static_cast<Eigen::Index>(i)) = r.plane.to_2d(row3(ws, static_cast<Index>(i))).transpose();
 

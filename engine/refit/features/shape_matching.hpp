@@ -13,7 +13,8 @@
 //  - two samples are fixed by the paper's heuristic (the two closest to body B,
 //    the two closest to curves already processed: the two smallest distances
 //    win), and every sample where the curve crosses an earlier curve is fixed
-//    where the earlier curve's optimised polyline put the crossing;
+//    where the earlier curve's optimised polyline put the crossing (the new
+//    plane is moved along its normal to pass through those points);
 //  - closed curves wrap their indices; open curves drop the end terms.
 #include <refit/features/feature_curves.hpp>
 #include <refit/warp/warp.hpp>
