@@ -4,10 +4,13 @@
 // absent. Asserts what holds today (every vertex written, no NaN, no more
 // vertices inside body B than the warp alone leaves, the written garment keeps
 // every curve no worse and all together better than the warp) and prints the
-// shape errors.
+// shape errors, also of held-out slices between the profiles.
 #include "support/test_support.hpp"
 
+#include <refit/attach/attachment.hpp>
 #include <refit/body/centre_tree.hpp>
+#include <refit/features/curve_metrics.hpp>
+#include <refit/features/feature_curves.hpp>
 #include <refit/io/body_io.hpp>
 #include <refit/io/obj_garment.hpp>
 #include <refit/pipeline/resize.hpp>
@@ -90,6 +93,45 @@ std::string profile_features(const Garment& g, const BodyMesh& a, const RealGarm
   return json + "\n] }\n";
 }
 
+// Held-out slices (not features): the skirt part cut by the vertical planes through
+// body A's centre at 45 degrees between the side and the front or back profiles.
+std::vector<FeatureCurve> held_out_slices(const Garment& g, const BodyMesh& a, const RealGarment& rg) {
+  Vec3 lo = Vec3::Constant(1e30), hi = -lo;
+  for (Eigen::Index i = 0; i < a.vertices.rows(); ++i)
+    if (std::abs(a.vertices(i, 1) - rg.y_top) < 2.0 && std::abs(a.vertices(i, 0)) < 18.0) {
+      lo = lo.cwiseMin(a.vertices.row(i).transpose());
+      hi = hi.cwiseMax(a.vertices.row(i).transpose());
+    }
+  const Vec3 centre = 0.5 * (lo + hi);
+  const double y_mid = 0.5 * (rg.y_top + rg.y_hem);
+  std::string json = "{ \"units\": \"cm\", \"features\": [\n";
+  const double r = std::sqrt(0.5);
+  struct Dir {
+    const char* name;
+    double dx, dz;
+  };
+  bool first = true;
+  for (const Dir& d : {Dir{"front-left", r, r}, Dir{"back-right", -r, -r}}) {
+    const Vec3 dir(d.dx, 0.0, d.dz), normal(d.dz, 0.0, -d.dx);
+    // The garment's outermost point at height y along dir, near the cut plane.
+    const auto outer = [&](double y) {
+      double reach = 0.0;
+      for (Index i = 0; i < g.vertex_count(); ++i) {
+        const Vec3 q = row3(g.positions, i) - centre;
+        if (std::abs(q.y() - (y - centre.y())) > 2.0 || std::abs(normal.dot(q)) > 4.0) continue;
+        reach = std::max(reach, dir.dot(q));
+      }
+      return Vec3(centre.x() + d.dx * reach, y, centre.z() + d.dz * reach);
+    };
+    json += std::string(first ? "" : ",\n") + "{ \"name\": \"" + d.name + "\", \"plane\": { \"point\": " + vec(centre) +
+            ", \"normal\": " + vec(normal) + " }, \"curve\": { \"kind\": \"slice\", \"near\": " + vec(outer(y_mid)) +
+            ", \"from\": " + vec(outer(rg.y_top)) + ", \"to\": " + vec(outer(rg.y_back_end)) +
+            ", \"control_points\": 12 }, \"samples\": 60 }";
+    first = false;
+  }
+  return build_feature_curves(g, parse_feature_json(json + "\n] }\n", "held_out.json"));
+}
+
 void resize_to_targets(const RealGarment& rg, const std::vector<std::string>& targets) {
   const std::string data = test::shared_data_dir();
   if (data.empty()) GTEST_SKIP() << "../shared/data is absent: real-data pipeline test skipped";
@@ -98,6 +140,9 @@ void resize_to_targets(const RealGarment& rg, const std::vector<std::string>& ta
   ResizeOptions options;
   options.metrics = true;
   const GarmentBinding binding(garment, a, options, parse_feature_json(profile_features(*garment, a, rg), "features.json"));
+  const std::vector<FeatureCurve> held_out = held_out_slices(*garment, a, rg);
+  std::vector<SurfaceAttachment> held_out_at;
+  for (const FeatureCurve& c : held_out) held_out_at.push_back(attach_points(*garment, c.samples));
   for (const std::string& target : targets) {
     SCOPED_TRACE(target);
     const ResizeResult r = binding.resize(read_body(data + "/bodies/" + target + ".obj"));
@@ -131,6 +176,15 @@ void resize_to_targets(const RealGarment& rg, const std::vector<std::string>& ta
     // optimised curves are 6,000-21,000x better than the warp, but eq. 14 holds the
     // surface agents within 1 cm of body B, along much of them, as warped.
     EXPECT_GT(sum_output_warped, 1.5 * sum_output);
+    // Held-out slices between the profiles: printed, not asserted. Measured 1.3x-2.6x
+    // on the skirt, 0.8x-1.2x on the dress (the 3x is not reached: most of
+    // the tight dress's agents are held as warped by eq. 14).
+    for (std::size_t k = 0; k < held_out.size(); ++k) {
+      const double warp = shape_error(carry(held_out_at[k], r.warped), held_out[k].samples, false);
+      const double out = shape_error(carry(held_out_at[k], r.positions), held_out[k].samples, false);
+      std::printf("[ info ]   held-out %-10s shape error: warp %.5f, written garment %.5f (%.1fx)\n", held_out[k].name.c_str(),
+                  warp, out, warp / std::max(out, 1e-12));
+    }
   }
 }
 
