@@ -41,6 +41,19 @@ std::string vec(const Vec3& p) {
   return s.str();
 }
 
+// Body A's centre: the middle of its bounding box at height y (|x| < 18 cm: the
+// torso, not the arms). The mean vertex is pulled forward by MakeHuman's dense
+// face, hands and feet (12 cm for the whole body), off the skirt's middle.
+Vec3 body_centre(const BodyMesh& a, double y) {
+  Vec3 lo = Vec3::Constant(1e30), hi = -lo;
+  for (Eigen::Index i = 0; i < a.vertices.rows(); ++i)
+    if (std::abs(a.vertices(i, 1) - y) < 2.0 && std::abs(a.vertices(i, 0)) < 18.0) {
+      lo = lo.cwiseMin(a.vertices.row(i).transpose());
+      hi = hi.cwiseMax(a.vertices.row(i).transpose());
+    }
+  return 0.5 * (lo + hi);
+}
+
 // Hem first (so each profile is held at both ends), then the left, right, front
 // and back profiles: the garment cut by the planes through body A's centre (mean
 // vertex of its skirt part): z = centre z (normal +Z) gives the left and right pieces, x = centre x
@@ -48,16 +61,7 @@ std::string vec(const Vec3& p) {
 // hem levels of the garment's skirt part.
 std::string profile_features(const Garment& g, const BodyMesh& a, const RealGarment& rg) {
   const double y_mid = 0.5 * (rg.y_top + rg.y_hem);
-  // Body A's centre: the middle of its bounding box at the waist level (|x| < 18 cm:
-  // the torso, not the arms). The mean vertex is pulled forward by MakeHuman's
-  // dense face, hands and feet (12 cm for the whole body), off the skirt's middle.
-  Vec3 lo = Vec3::Constant(1e30), hi = -lo;
-  for (Eigen::Index i = 0; i < a.vertices.rows(); ++i)
-    if (std::abs(a.vertices(i, 1) - rg.y_top) < 2.0 && std::abs(a.vertices(i, 0)) < 18.0) {
-      lo = lo.cwiseMin(a.vertices.row(i).transpose());
-      hi = hi.cwiseMax(a.vertices.row(i).transpose());
-    }
-  const Vec3 centre = 0.5 * (lo + hi);
+  const Vec3 centre = body_centre(a, rg.y_top);
   // The garment's outermost point at height y in the direction (dx, dz), on the cut plane.
   // (Coarse garments have few vertices near any plane: take the farthest vertex
   // in a band around it and put the point on the plane at that distance.)
@@ -96,13 +100,7 @@ std::string profile_features(const Garment& g, const BodyMesh& a, const RealGarm
 // Held-out slices (not features): the skirt part cut by the vertical planes through
 // body A's centre at 45 degrees between the side and the front or back profiles.
 std::vector<FeatureCurve> held_out_slices(const Garment& g, const BodyMesh& a, const RealGarment& rg) {
-  Vec3 lo = Vec3::Constant(1e30), hi = -lo;
-  for (Eigen::Index i = 0; i < a.vertices.rows(); ++i)
-    if (std::abs(a.vertices(i, 1) - rg.y_top) < 2.0 && std::abs(a.vertices(i, 0)) < 18.0) {
-      lo = lo.cwiseMin(a.vertices.row(i).transpose());
-      hi = hi.cwiseMax(a.vertices.row(i).transpose());
-    }
-  const Vec3 centre = 0.5 * (lo + hi);
+  const Vec3 centre = body_centre(a, rg.y_top);
   const double y_mid = 0.5 * (rg.y_top + rg.y_hem);
   std::string json = "{ \"units\": \"cm\", \"features\": [\n";
   const double r = std::sqrt(0.5);
