@@ -1,5 +1,6 @@
 #include <refit/core/error.hpp>
 #include <refit/io/atomic_file.hpp>
+#include <refit/io/file_bytes.hpp>
 
 #include <refit/core/parallel.hpp>
 
@@ -52,21 +53,9 @@ void write_parts_atomically(const std::string& path, std::size_t count, const Pa
       for (std::size_t i = 0; i < m; ++i) offset[i + 1] = offset[i] + static_cast<off_t>(buffer[i].size());
       parallel_for(0, m, 1, [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e && error.load() == 0; ++i) {
-          const char* data = buffer[i].data();
-          std::size_t left = buffer[i].size();
-          off_t at = offset[i];
-          while (left > 0) {
-            const ssize_t n = ::pwrite(fd, data, left, at);
-            if (n < 0 && errno == EINTR) continue;
-            if (n <= 0) {
-              int expected = 0;
-              error.compare_exchange_strong(expected, n < 0 ? errno : EIO);
-              return;
-            }
-            data += n;
-            left -= static_cast<std::size_t>(n);
-            at += n;
-          }
+          const int failed = transfer_all(fd, buffer[i].data(), buffer[i].size(), offset[i], true);
+          int expected = 0;
+          if (failed != 0) error.compare_exchange_strong(expected, failed < 0 ? EIO : failed);
         }
       });
       if (error.load() != 0) throw input_error(path, std::string("write failed: ") + std::strerror(error.load()));

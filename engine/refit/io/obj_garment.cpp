@@ -5,7 +5,6 @@
 #include <refit/io/atomic_file.hpp>
 
 #include <algorithm>
-#include <atomic>
 #include <bit>
 #include <cerrno>
 #include <charconv>
@@ -15,9 +14,6 @@
 #include <optional>
 #include <utility>
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 namespace refit {
 namespace {
@@ -612,40 +608,7 @@ Garment parse_garment_obj(std::string_view text, const std::string& file_for_err
   return parse_owned(TextBytes(text), file_for_errors);
 }
 
-Garment read_garment_obj(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) throw input_error(path, std::string("cannot open: ") + std::strerror(errno));
-  struct stat st {};
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    ::close(fd);
-    throw input_error(path, "cannot read: not a regular file");
-  }
-  // Ranges of the file read by several threads at once: the kernel's copy and the
-  // first touch of the buffer's pages were most of a large garment's read time.
-  TextBytes bytes(static_cast<std::size_t>(st.st_size));
-  constexpr std::size_t kRange = std::size_t(1) << 23;
-  std::atomic<int> error{0};  // errno of the first failure, or -1 when the file ended early
-  parallel_for(0, (bytes.size() + kRange - 1) / kRange, 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t r = b; r < e && error.load() == 0; ++r) {
-      std::size_t at = r * kRange;
-      const std::size_t end = std::min(bytes.size(), at + kRange);
-      while (at < end) {
-        const ssize_t got = ::pread(fd, bytes.data() + at, end - at, static_cast<off_t>(at));
-        if (got < 0 && errno == EINTR) continue;
-        if (got <= 0) {
-          int expected = 0;
-          error.compare_exchange_strong(expected, got < 0 ? errno : -1);
-          return;
-        }
-        at += static_cast<std::size_t>(got);
-      }
-    }
-  });
-  ::close(fd);
-  if (error.load() > 0) throw input_error(path, std::string("cannot read: ") + std::strerror(error.load()));
-  if (error.load() < 0) throw input_error(path, "cannot read the whole file (it got shorter while being read)");
-  return parse_owned(std::move(bytes), path);
-}
+Garment read_garment_obj(const std::string& path) { return parse_owned(read_file_bytes(path), path); }
 
 std::string format_garment_obj(const Garment& g, ObjWriteReport* report) {
   ObjWriteReport local;

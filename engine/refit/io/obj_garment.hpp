@@ -5,32 +5,15 @@
 // for line with only the positions (and the normals that follow from them)
 // changed.
 #include <refit/core/garment.hpp>
+#include <refit/io/file_bytes.hpp>
 
-#include <algorithm>
 #include <cstddef>
 #include <cstdint>
-#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace refit {
-
-/// A file's bytes. Unlike std::string it is made without zero-filling, so a large
-/// file goes straight into fresh pages, several threads reading at once.
-class TextBytes {
- public:
-  TextBytes() = default;
-  explicit TextBytes(std::size_t size) : data_(new char[size]), size_(size) {}  // contents unset
-  explicit TextBytes(std::string_view text) : TextBytes(text.size()) { std::copy(text.begin(), text.end(), data_.get()); }
-  char* data() { return data_.get(); }
-  std::size_t size() const { return size_; }
-  std::string_view view() const { return {data_.get(), size_}; }
-
- private:
-  std::unique_ptr<char[]> data_;
-  std::size_t size_ = 0;
-};
 
 /// What a writer needs to give an OBJ file back line for line: the original text
 /// and where in it the numbers that change live.

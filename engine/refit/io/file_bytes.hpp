@@ -1,0 +1,41 @@
+#pragma once
+// Whole files in and out in parallel ranges: the byte buffer a garment file is
+// read into, and the pread/pwrite loop shared by the reader and the atomic writer.
+#include <sys/types.h>
+
+#include <algorithm>
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <string_view>
+
+namespace refit {
+
+/// A file's bytes. Unlike std::string it is made without zero-filling, so a large
+/// file goes straight into fresh pages, several threads reading at once.
+class TextBytes {
+ public:
+  TextBytes() = default;
+  explicit TextBytes(std::size_t size) : data_(new char[size]), size_(size) {}  // contents unset
+  explicit TextBytes(std::string_view text) : TextBytes(text.size()) { std::copy(text.begin(), text.end(), data_.get()); }
+  char* data() { return data_.get(); }
+  std::size_t size() const { return size_; }
+  std::string_view view() const { return {data_.get(), size_}; }
+
+ private:
+  std::unique_ptr<char[]> data_;
+  std::size_t size_ = 0;
+};
+
+/// Moves all `size` bytes between `data` and the file `fd` at offset `at`
+/// (pwrite when `write`, else pread), retrying short transfers and EINTR.
+/// Returns 0, the errno of a failure, or -1 when the file ended first.
+int transfer_all(int fd, char* data, std::size_t size, off_t at, bool write);
+
+/// The whole regular file at `path`, read by several threads in 8 MB ranges (the
+/// kernel's copy and the first touch of the pages were most of a large garment's
+/// read time on one thread). Throws refit::Error naming `path` when it cannot be
+/// opened, is not a regular file, or cannot be read whole.
+TextBytes read_file_bytes(const std::string& path);
+
+}  // namespace refit
