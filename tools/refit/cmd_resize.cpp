@@ -54,6 +54,7 @@ int run(const ResizeArgs& a) {
     options.surface.emit_from_original = false;
     options.surface.smooth_passes = 0;
     options.surface.keep_clear_of_body = false;
+    options.surface.snap_to_features = false;
   }
   options.collision = !a.no_collision;
   options.metrics = a.metrics;
@@ -148,13 +149,18 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
   app.add_option("--agents", a->surface.agent_budget, "Agent budget for the automatic voxel size")->capture_default_str();
   app.add_option("--epsilon", a->surface.epsilon, "Agents closer than this to body B (cm) keep their warped position")
       ->capture_default_str();
+  app.add_option("--feature-zone", a->surface.feature_zone_rings,
+                 "Within this many one-ring steps of a feature, the feature wins over --epsilon (tight garments)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--max-iterations", a->surface.max_iterations, "Gauss-Seidel iterations, at most")->capture_default_str();
   app.add_option("--tolerance", a->surface.tolerance, "Gauss-Seidel stops below this update norm")->capture_default_str();
   app.add_flag("--plain-sweeps", a->plain_sweeps,
                "The paper's plain Gauss-Seidel sweeps instead of multigrid cycles (same solution when both converge)");
   app.add_flag("--encode-on-warped", a->encode_on_warped, "Encode the local shape on the warped garment, not the original");
   app.add_flag("--paper-surface", a->paper_surface,
-               "Surface reconstruction as the paper: fan-normal frames, eq. 4 blend of the warped vertices, no smoothing");
+               "Surface reconstruction as the paper: fan-normal frames, eq. 4 blend of the warped vertices, no smoothing, "
+               "no snap to the features");
   app.add_flag("--no-collision", a->no_collision, "Do not push vertices inside body B out");
   app.add_option("--clearance", a->clearance, "Collision clearance outside body B in cm")->capture_default_str();
   app.add_flag("--metrics", a->metrics, "Add fit, penetration and surface metrics of the warp and the result to the report");

@@ -4,6 +4,7 @@
 #include <refit/core/parallel.hpp>
 #include <refit/core/progress.hpp>
 #include <refit/surface/agents.hpp>
+#include <refit/surface/feature_snap.hpp>
 #include <refit/surface/surface.hpp>
 
 #include <Eigen/SparseCore>
@@ -41,6 +42,9 @@ void check_options(const SurfaceOptions& o) {
   if (!(o.multigrid_overcorrection > 0.0 && o.multigrid_overcorrection < 2.0))
     throw bad("multigrid over-correction must lie in (0, 2)");
   if (o.max_reach_agents == 0 || o.max_reach_agents > 255) throw bad("max reach agents must be 1 to 255");
+  if (o.feature_zone_rings < 0) throw bad("feature zone must be 0 or more one-ring steps");
+  if (!(o.snap_regularisation > 0.0) || !std::isfinite(o.snap_regularisation))
+    throw bad("snap regularisation must be positive");
 }
 
 // Connected groups of a one-ring graph: group[a] = the lowest agent of a's group.
@@ -199,6 +203,20 @@ SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, co
   // re-emits the same point, so this only has to be consistent, not B-specific.
   if (!options.fit_rotations) s.flip_ = orient_normals(fan_normals(s.original_agents_, s.ring_, s.ring_open_), s.ring_);
   s.group_ = ring_groups(s.ring_);
+  // The features' zone: agents within feature_zone_rings one-ring steps (either
+  // direction) of a feature agent.
+  if (options.feature_zone_rings > 0) {
+    s.near_feature_.assign(n, 0);
+    for (std::size_t a = 0; a < n; ++a) s.near_feature_[a] = s.feature_of_[a] >= 0;
+    for (int k = 0; k < options.feature_zone_rings; ++k) {
+      std::vector<std::uint8_t> grown = s.near_feature_;
+      for (std::size_t a = 0; a < n; ++a)
+        for (Index q : s.ring_.row(a))
+          if (s.near_feature_[a] || s.near_feature_[q]) grown[a] = grown[q] = 1;
+      s.near_feature_ = std::move(grown);
+    }
+    st.feature_zone_agents = std::size_t(std::count(s.near_feature_.begin(), s.near_feature_.end(), 1));
+  }
   s.groups_ = 0;
   for (std::size_t a = 0; a < n; ++a) s.groups_ += s.group_[a] == a;
   st.ms.one_ring = clock.ms();
@@ -340,6 +358,12 @@ SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, co
     }
   } else {
     s.reach_.offsets.assign(nv + 1, 0);
+  }
+  if (options.feature_zone_rings > 0) {
+    s.carries_feature_.assign(nv, 0);
+    for (std::size_t k = 0; k < s.feature_attachment_.vertex.size(); ++k)
+      for (int j = 0; j < 3; ++j)
+        if (s.feature_attachment_.weight[k][j] != 0.0) s.carries_feature_[s.feature_attachment_.vertex[k][j]] = 1;
   }
   if (options.emit_from_original && !options.encode_on_warped) s.original_vertices_ = g.positions;
   st.ms.reconstruct = clock.ms();  // bind share of the reconstruction (vertex lists)
@@ -534,7 +558,8 @@ SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
   const Points before = agent_positions(warped, fwarped);
 
   // Constraints: eq. 15 for feature agents, eq. 14 within epsilon of body B
-  // (or inside it: the distance is signed). fixed: 2 feature, 1 body, 3 clearance.
+  // (or inside it: the distance is signed) except in the features' zone (see
+  // SurfaceOptions::feature_zone_rings). fixed: 2 feature, 1 body, 3 clearance.
   std::vector<std::uint8_t> fixed(n, 0);
   std::vector<double> body_distance(n, 0.0);
   parallel_for(0, n, 256, [&](std::size_t b, std::size_t e) {
@@ -543,7 +568,7 @@ SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
         fixed[a] = 2;
       } else {
         body_distance[a] = distance(row3(before, Index(a)));
-        if (body_distance[a] < options_.epsilon) fixed[a] = 1;
+        if (body_distance[a] < options_.epsilon && (near_feature_.empty() || !near_feature_[a])) fixed[a] = 1;
       }
     }
   });
@@ -793,6 +818,7 @@ SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
     res.positions = reconstruct_rotations(orig ? original_vertices_ : warped, from, x, rot, reach_, reach_weight_,
                                           nearest_, keep, &warped);
   }
+  std::vector<std::uint8_t> kept_vertex;
   if (options_.keep_near_vertices && n > 0) {
     // Eq. 14 for the vertices too: blending frames of nearby free agents must not
     // pull a vertex that touches the body. Only vertices the nearest agent's
@@ -801,6 +827,7 @@ SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
     parallel_for(0, vertex_count_, 1024, [&](std::size_t b, std::size_t e) {
       for (std::size_t v = b; v < e; ++v) {
         const Index a = nearest_[v];
+        if (!near_feature_.empty() && (near_feature_[a] || carries_feature_[v])) continue;
         const Vec3 p = row3(warped, Index(v));
         if (feature_of_[a] < 0 && body_distance[a] - (p - row3(before, a)).norm() >= options_.epsilon) continue;
         if (distance(p) < options_.epsilon) {
@@ -810,6 +837,15 @@ SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
       }
     });
     st.vertices_kept = std::accumulate(kept.begin(), kept.end(), std::size_t{0});
+    kept_vertex = std::move(kept);
+  }
+  if (options_.snap_to_features && !near_feature_.empty() && nf > 0 && !feature_attachment_.vertex.empty()) {
+    const FeatureSnapReport snap = snap_to_features(res.positions, targets, feature_attachment_, reach_, reach_weight_,
+                                                    feature_of_, kept_vertex, options_.snap_regularisation);
+    st.feature_gap_before_snap = snap.gap_before;
+    st.feature_gap = snap.gap_after;
+    st.vertices_snapped = snap.vertices_moved;
+    st.feature_samples_kept = snap.samples_held;
   }
   res.agents = std::move(x);
   st.ms.reconstruct = clock.ms();

@@ -35,6 +35,14 @@ struct SurfaceOptions {
   double block_voxels = 8.0;       // solver blocks are at least this many voxels wide (and wider than any one-ring edge)
   std::size_t max_reach_agents = 8;   // a vertex blends its nearest agents (at most this many, within reach)
   bool keep_near_vertices = true;  // garment vertices closer than epsilon to body B keep their warped positions too
+  int feature_zone_rings = 0;      // beyond the paper: within this many one-ring steps of a feature agent (and on the
+                                   // faces a feature sample sits on) the feature wins over eq. 14: agents there are not
+                                   // held at their warped positions and vertices are not kept. 0 = the paper's rule: a
+                                   // feature running within epsilon of the body (tight garments) then mostly stays as
+                                   // warped. The clearance rounds and the collision step still keep the zone off the body
+  bool snap_to_features = true;    // beyond the paper: correct the vertices near the features so that the written
+                                   // garment passes through the optimised curves (see feature_snap.hpp)
+  double snap_regularisation = 1e-3;  // Tikhonov weight of that correction, relative to its normal equations' diagonal
   bool keep_clear_of_body = true;  // free agents the solve leaves closer than `clearance` to body B (or inside) are held
                                    // at that clearance and the system is solved again (see apply; false: the paper)
   double clearance = 0.4;          // garment units (the pipeline passes twice its collision clearance, so vertices
@@ -83,6 +91,12 @@ struct SurfaceStats {
   std::size_t vertices_kept = 0;           // vertices within epsilon of body B, left at their warped positions
   int levels = 1;                          // solve levels (1 + coarse levels)
   int coarse_iterations = 0;               // Gauss-Seidel iterations spent on the coarse levels
+  std::size_t feature_zone_agents = 0;     // agents in the features' zone (feature agents included; 0 without a zone)
+  double feature_gap_before_snap = 0.0;    // largest distance from a feature sample carried on the output to its target
+  double feature_gap = 0.0;                // the same after the snap (both 0 when the snap is off; samples on kept
+                                           // vertices left out)
+  std::size_t feature_samples_kept = 0;    // feature samples on vertices kept as warped (not snapped)
+  std::size_t vertices_snapped = 0;        // vertices the snap moved
   SurfaceTimings ms;
 };
 
@@ -167,6 +181,8 @@ class SurfaceBinding {
   std::vector<std::array<Index, 3>> src_vertex_;
   std::vector<std::array<double, 3>> src_weight_;
   std::vector<std::int32_t> feature_of_;
+  std::vector<std::uint8_t> near_feature_;     // per agent: in the features' zone (empty without a zone)
+  std::vector<std::uint8_t> carries_feature_;  // per vertex: a corner of a face a feature sample sits on (with a zone)  // within feature_zone_rings one-ring steps of a feature agent
   std::vector<Index> feature_slot_;
   SurfaceAttachment feature_attachment_;  // where each feature sample sits on the original garment
   Points original_agents_;

@@ -1,0 +1,41 @@
+#pragma once
+// Beyond the paper: the last step of the surface stage makes the written
+// garment pass through the optimised feature curves.
+//
+// The reconstruction re-emits each vertex as a blend of its nearby agents, so
+// a feature sample carried on the output's faces lands near, not on, its
+// optimised position. The paper's surface interpolates the feature agents; a
+// mesh only does when its vertices are corrected. The correction is carried by
+// the feature agents through the same smooth blend weights the reconstruction
+// used: vertex v moves by sum_a w(v, a) c_a over the feature agents a in its
+// reach, and the c solve one small least-squares problem (one row per feature
+// sample, Tikhonov-regularised) so the carried samples reach their targets.
+// The correction is smooth (it fades with the blend weights over the reach)
+// and zero where the reconstruction already hit the targets (A = B).
+#include <refit/attach/attachment.hpp>
+#include <refit/core/types.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace refit {
+
+struct FeatureSnapReport {
+  double gap_before = 0.0;       // largest distance from a carried feature sample to its target (samples not on a
+  double gap_after = 0.0;        // held vertex), before and after the correction (what remains: samples in conflict)
+  std::size_t samples_held = 0;  // samples on a held vertex: they stay where they are
+  std::size_t vertices_moved = 0;
+};
+
+/// Corrects `positions` (every garment vertex) so that the feature samples
+/// attached by `attachment` reach `targets`. `reach`/`reach_weight`: each
+/// vertex's agents and normalised blend weights; `feature_of`: per agent, its
+/// feature sample or -1; `held`: vertices that must not move (empty: none).
+/// `regularisation`: Tikhonov weight relative to the mean diagonal of the
+/// normal equations. Deterministic for any thread count.
+FeatureSnapReport snap_to_features(Points& positions, const Points& targets, const SurfaceAttachment& attachment,
+                                   const Csr& reach, const std::vector<float>& reach_weight,
+                                   const std::vector<std::int32_t>& feature_of, const std::vector<std::uint8_t>& held,
+                                   double regularisation);
+
+}  // namespace refit
