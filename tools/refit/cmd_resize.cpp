@@ -55,6 +55,7 @@ int run(const ResizeArgs& a) {
     options.surface.smooth_passes = 0;
     options.surface.keep_clear_of_body = false;
     options.surface.snap_to_features = false;
+    options.surface.feature_zone_rings = 0;
   }
   options.collision = !a.no_collision;
   options.metrics = a.metrics;
@@ -150,7 +151,8 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
   app.add_option("--epsilon", a->surface.epsilon, "Agents closer than this to body B (cm) keep their warped position")
       ->capture_default_str();
   app.add_option("--feature-zone", a->surface.feature_zone_rings,
-                 "Within this many one-ring steps of a feature, the feature wins over --epsilon (tight garments)")
+                 "Within this many one-ring steps of a feature, the feature wins over --epsilon and the garment is "
+                 "snapped through it (0 = the paper: --epsilon everywhere but on the features)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   app.add_option("--max-iterations", a->surface.max_iterations, "Gauss-Seidel iterations, at most")->capture_default_str();
@@ -159,8 +161,8 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
                "The paper's plain Gauss-Seidel sweeps instead of multigrid cycles (same solution when both converge)");
   app.add_flag("--encode-on-warped", a->encode_on_warped, "Encode the local shape on the warped garment, not the original");
   app.add_flag("--paper-surface", a->paper_surface,
-               "Surface reconstruction as the paper: fan-normal frames, eq. 4 blend of the warped vertices, no smoothing, "
-               "no snap to the features");
+               "Surface step as the paper: fan-normal frames, eq. 4 blend of the warped vertices, no smoothing, "
+               "--feature-zone 0");
   app.add_flag("--no-collision", a->no_collision, "Do not push vertices inside body B out");
   app.add_option("--clearance", a->clearance, "Collision clearance outside body B in cm")->capture_default_str();
   app.add_flag("--metrics", a->metrics, "Add fit, penetration and surface metrics of the warp and the result to the report");

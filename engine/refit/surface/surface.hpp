@@ -35,12 +35,14 @@ struct SurfaceOptions {
   double block_voxels = 8.0;       // solver blocks are at least this many voxels wide (and wider than any one-ring edge)
   std::size_t max_reach_agents = 8;   // a vertex blends its nearest agents (at most this many, within reach)
   bool keep_near_vertices = true;  // garment vertices closer than epsilon to body B keep their warped positions too
-  int feature_zone_rings = 0;      // beyond the paper: within this many one-ring steps of a feature agent (and on the
-                                   // faces a feature sample sits on) the feature wins over eq. 14: agents there are not
-                                   // held at their warped positions and vertices are not kept. 0 = the paper's rule: a
-                                   // feature running within epsilon of the body (tight garments) then mostly stays as
-                                   // warped. The clearance rounds and the collision step still keep the zone off the body
-  bool snap_to_features = true;    // beyond the paper: correct the vertices near the features so that the written
+  int feature_zone_rings = 1;      // beyond the paper: within this many one-ring steps of a feature agent, and on the
+                                   // faces a feature sample sits on, the feature wins over eq. 14: agents there are not
+                                   // held at their warped positions, vertices are not kept, and the garment is snapped
+                                   // through the optimised curves. 0 = the paper's rule (eq. 14 everywhere but on the
+                                   // feature agents), under which a feature running within epsilon of the body (the side
+                                   // seams of a tight dress) mostly stays as warped. The clearance rounds and the
+                                   // collision step still keep the zone off the body
+  bool snap_to_features = true;    // with a feature zone: correct the vertices near the features so that the written
                                    // garment passes through the optimised curves (see feature_snap.hpp)
   double snap_regularisation = 1e-3;  // Tikhonov weight of that correction, relative to its normal equations' diagonal
   bool keep_clear_of_body = true;  // free agents the solve leaves closer than `clearance` to body B (or inside) are held
@@ -182,7 +184,7 @@ class SurfaceBinding {
   std::vector<std::array<double, 3>> src_weight_;
   std::vector<std::int32_t> feature_of_;
   std::vector<std::uint8_t> near_feature_;     // per agent: in the features' zone (empty without a zone)
-  std::vector<std::uint8_t> carries_feature_;  // per vertex: a corner of a face a feature sample sits on (with a zone)  // within feature_zone_rings one-ring steps of a feature agent
+  std::vector<std::uint8_t> carries_feature_;  // per vertex: a corner of a face a feature sample sits on (with a zone)
   std::vector<Index> feature_slot_;
   SurfaceAttachment feature_attachment_;  // where each feature sample sits on the original garment
   Points original_agents_;
