@@ -46,7 +46,6 @@ nlohmann::json surface_report(const SurfaceStats& s) {
           {"feature_gap_before_snap", s.feature_gap_before_snap},
           {"feature_gap", s.feature_gap},
           {"vertices_snapped", s.vertices_snapped},
-          {"feature_samples_kept", s.feature_samples_kept},
           {"levels", s.levels},
           {"coarse_iterations", s.coarse_iterations},
           {"timings_ms",

@@ -845,7 +845,6 @@ SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
     st.feature_gap_before_snap = snap.gap_before;
     st.feature_gap = snap.gap_after;
     st.vertices_snapped = snap.vertices_moved;
-    st.feature_samples_kept = snap.samples_held;
   }
   res.agents = std::move(x);
   st.ms.reconstruct = clock.ms();

@@ -95,9 +95,7 @@ struct SurfaceStats {
   int coarse_iterations = 0;               // Gauss-Seidel iterations spent on the coarse levels
   std::size_t feature_zone_agents = 0;     // agents in the features' zone (feature agents included; 0 without a zone)
   double feature_gap_before_snap = 0.0;    // largest distance from a feature sample carried on the output to its target
-  double feature_gap = 0.0;                // the same after the snap (both 0 when the snap is off; samples on kept
-                                           // vertices left out)
-  std::size_t feature_samples_kept = 0;    // feature samples on vertices kept as warped (not snapped)
+  double feature_gap = 0.0;                // the same after the snap (both 0 when the snap is off)
   std::size_t vertices_snapped = 0;        // vertices the snap moved
   SurfaceTimings ms;
 };
