@@ -7,6 +7,8 @@
 #include <refit/io/obj_garment.hpp>
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
@@ -86,8 +88,10 @@ TEST(Cli, PaperVariantsRunAndChangeTheResult) {
   const std::string ours = c.dir.file("ours.obj");
   ASSERT_EQ(run_cli(c.resize(ours, feats)).exit_code, 0);
   const Garment base = read_garment_obj(ours);
-  for (const char* flag : {"--paper-surface", "--paper-closeness", "--encode-on-warped", "--plain-sweeps"}) {
-    const std::string out = c.dir.file(std::string(flag + 2) + ".obj");
+  for (const char* flag : {"--paper-surface", "--paper-closeness", "--encode-on-warped", "--plain-sweeps", "--feature-zone 0"}) {
+    std::string name = flag + 2;
+    std::replace(name.begin(), name.end(), ' ', '_');
+    const std::string out = c.dir.file(name + ".obj");
     const auto r = run_cli(c.resize(out, feats + flag));
     ASSERT_EQ(r.exit_code, 0) << flag << ": " << r.err;
     const Garment g = read_garment_obj(out);

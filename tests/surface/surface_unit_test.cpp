@@ -358,6 +358,14 @@ TEST(SurfaceBindingTest, BadInputThrowsOneClearLine) {
   o.voxel = -1;
   EXPECT_THROW(SurfaceBinding::bind(g, Points(0, 3), o), Error);
   o.voxel = 1.0;
+  for (const int zone : {-1, 17}) {
+    SurfaceOptions z = o;
+    z.feature_zone_rings = zone;
+    EXPECT_THROW(SurfaceBinding::bind(g, Points(0, 3), z), Error) << zone;
+  }
+  SurfaceOptions reg = o;
+  reg.snap_regularisation = 0.0;
+  EXPECT_THROW(SurfaceBinding::bind(g, Points(0, 3), reg), Error);
   Points bad(1, 3);
   bad << 0, std::nan(""), 0;
   EXPECT_THROW(SurfaceBinding::bind(g, bad, o), Error);

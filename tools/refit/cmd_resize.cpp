@@ -154,7 +154,7 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
                  "Within this many one-ring steps of a feature, the feature wins over --epsilon and the garment is "
                  "snapped through it (0 = the paper: --epsilon everywhere but on the features)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, 16));
   app.add_option("--max-iterations", a->surface.max_iterations, "Gauss-Seidel iterations, at most")->capture_default_str();
   app.add_option("--tolerance", a->surface.tolerance, "Gauss-Seidel stops below this update norm")->capture_default_str();
   app.add_flag("--plain-sweeps", a->plain_sweeps,

@@ -42,7 +42,7 @@ void check_options(const SurfaceOptions& o) {
   if (!(o.multigrid_overcorrection > 0.0 && o.multigrid_overcorrection < 2.0))
     throw bad("multigrid over-correction must lie in (0, 2)");
   if (o.max_reach_agents == 0 || o.max_reach_agents > 255) throw bad("max reach agents must be 1 to 255");
-  if (o.feature_zone_rings < 0) throw bad("feature zone must be 0 or more one-ring steps");
+  if (o.feature_zone_rings < 0 || o.feature_zone_rings > 16) throw bad("feature zone must be 0 to 16 one-ring steps");
   if (!(o.snap_regularisation > 0.0) || !std::isfinite(o.snap_regularisation))
     throw bad("snap regularisation must be positive");
 }
@@ -213,6 +213,7 @@ SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, co
       for (std::size_t a = 0; a < n; ++a)
         for (Index q : s.ring_.row(a))
           if (s.near_feature_[a] || s.near_feature_[q]) grown[a] = grown[q] = 1;
+      if (grown == s.near_feature_) break;  // the zone covers the features' groups
       s.near_feature_ = std::move(grown);
     }
     st.feature_zone_agents = std::size_t(std::count(s.near_feature_.begin(), s.near_feature_.end(), 1));

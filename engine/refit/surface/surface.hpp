@@ -41,7 +41,7 @@ struct SurfaceOptions {
                                    // through the optimised curves. 0 = the paper's rule (eq. 14 everywhere but on the
                                    // feature agents), under which a feature running within epsilon of the body (the side
                                    // seams of a tight dress) mostly stays as warped. The clearance rounds and the
-                                   // collision step still keep the zone off the body
+                                   // collision step still keep the zone off the body. At most 16
   bool snap_to_features = true;    // with a feature zone: correct the vertices near the features so that the written
                                    // garment passes through the optimised curves (see feature_snap.hpp)
   double snap_regularisation = 1e-3;  // Tikhonov weight of that correction, relative to its normal equations' diagonal
