@@ -7,10 +7,9 @@
 #include <refit/io/obj_garment.hpp>
 
 #include <gtest/gtest.h>
-
-#include <algorithm>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
