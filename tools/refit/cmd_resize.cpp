@@ -54,8 +54,7 @@ int run(const ResizeArgs& a) {
     options.surface.emit_from_original = false;
     options.surface.smooth_passes = 0;
     options.surface.keep_clear_of_body = false;
-    options.surface.snap_to_features = false;
-    options.surface.feature_zone_rings = 0;
+    options.surface.feature_zone_rings = 0;  // no zone, no snap
   }
   options.collision = !a.no_collision;
   options.metrics = a.metrics;

@@ -34,11 +34,8 @@ FeatureSnapReport snap_to_features(Points& positions, const Points& targets, con
   for (std::size_t k = 0; k < std::size_t(nf); ++k)
     for (int j = 0; j < 3; ++j) on_held[k] |= at.weight[k][j] != 0.0 && is_held(at.vertex[k][j]);
   rep.samples_held = std::size_t(std::count(on_held.begin(), on_held.end(), 1));
-  rep.gap_before = largest_gap(positions, targets, at, on_held);
-  if (nf == 0 || reach_weight.empty() || !(rep.gap_before > 0.0)) {
-    rep.gap_after = rep.gap_before;
-    return rep;
-  }
+  rep.gap_before = rep.gap_after = largest_gap(positions, targets, at, on_held);
+  if (nf == 0 || reach_weight.empty() || !(rep.gap_before > 0.0)) return rep;
   // Row k: how sample k's carried position moves with each feature agent's correction.
   Eigen::MatrixXd residual(nf, 3);
   std::vector<Eigen::Triplet<double>> entries;
@@ -58,10 +55,7 @@ FeatureSnapReport snap_to_features(Points& positions, const Points& targets, con
   a.setFromTriplets(entries.begin(), entries.end());
   Eigen::SparseMatrix<double> normal = a.transpose() * a;
   const double mean_diagonal = normal.diagonal().sum() / double(nf);
-  if (!(mean_diagonal > 0.0)) {
-    rep.gap_after = rep.gap_before;
-    return rep;
-  }
+  if (!(mean_diagonal > 0.0)) return rep;
   // The regularisation keeps corrections bounded where samples conflict (two
   // curves crossing one coarse face with slightly different targets) or where
   // a sample's vertices see a feature agent only faintly.
@@ -69,10 +63,7 @@ FeatureSnapReport snap_to_features(Points& positions, const Points& targets, con
   identity.setIdentity();
   normal += (regularisation * mean_diagonal) * identity;
   const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(normal);
-  if (ldlt.info() != Eigen::Success) {
-    rep.gap_after = rep.gap_before;
-    return rep;
-  }
+  if (ldlt.info() != Eigen::Success) return rep;
   const Eigen::MatrixXd c = ldlt.solve(Eigen::MatrixXd(a.transpose() * residual));
   std::vector<std::uint8_t> moved(positions.rows(), 0);
   parallel_for(0, std::size_t(positions.rows()), 4096, [&](std::size_t b, std::size_t e) {
