@@ -3,11 +3,13 @@
 // with the hem and four side profiles as features. Skips when ../shared/data is
 // absent. Asserts what holds today (every vertex written, no NaN, no more
 // vertices inside body B than the warp alone leaves, the written garment keeps
-// every curve no worse and all together better than the warp) and prints the
-// shape errors, also of held-out slices between the profiles.
+// every curve no worse and all together better than the warp, the skirt's
+// held-out slices between the profiles better than the warp where they stand
+// off the body) and prints the shape errors.
 #include "support/test_support.hpp"
 
 #include <refit/attach/attachment.hpp>
+#include <refit/body/body_surface.hpp>
 #include <refit/body/centre_tree.hpp>
 #include <refit/features/curve_metrics.hpp>
 #include <refit/features/feature_curves.hpp>
@@ -130,9 +132,24 @@ std::vector<FeatureCurve> held_out_slices(const Garment& g, const BodyMesh& a, c
   return build_feature_curves(g, parse_feature_json(json + "\n] }\n", "held_out.json"));
 }
 
+// The longest run of samples [first, first + count) of `warped` at least
+// `epsilon` from body B: the part of a curve that eq. 14 does not hold as warped.
+std::pair<Index, Index> off_body_run(const Points& warped, const BodySurface& b, double epsilon) {
+  std::pair<Index, Index> best{0, 0};
+  Index start = 0;
+  for (Index i = 0; i <= warped.rows(); ++i)
+    if (i == warped.rows() || b.signed_distance(row3(warped, i)) < epsilon) {
+      if (i - start > best.second) best = {start, i - start};
+      start = i + 1;
+    }
+  return best;
+}
+
 // zone: SurfaceOptions::feature_zone_rings; side_gain: the written side profiles'
-// least gain over the warp that is asserted (0: printed only).
-void resize_to_targets(const RealGarment& rg, const std::vector<std::string>& targets, int zone, double side_gain = 0.0) {
+// least gain over the warp that is asserted (0: printed only); held_out_gain: the
+// same for the off-body part of the held-out slices (0: printed only).
+void resize_to_targets(const RealGarment& rg, const std::vector<std::string>& targets, int zone, double side_gain = 0.0,
+                       double held_out_gain = 0.0) {
   const std::string data = test::shared_data_dir();
   if (data.empty()) GTEST_SKIP() << "../shared/data is absent: real-data pipeline test skipped";
   auto garment = std::make_shared<const Garment>(read_garment_obj(data + "/garments/" + rg.file));
@@ -147,7 +164,9 @@ void resize_to_targets(const RealGarment& rg, const std::vector<std::string>& ta
   for (const FeatureCurve& c : held_out) held_out_at.push_back(attach_points(*garment, c.samples));
   for (const std::string& target : targets) {
     SCOPED_TRACE(target);
-    const ResizeResult r = binding.resize(read_body(data + "/bodies/" + target + ".obj"));
+    const BodyMesh b = read_body(data + "/bodies/" + target + ".obj");
+    const BodySurface b_surface(b);
+    const ResizeResult r = binding.resize(b);
     ASSERT_EQ(r.positions.rows(), garment->positions.rows());
     ASSERT_TRUE(r.positions.allFinite());
     const auto& m = r.report.at("metrics");
@@ -181,15 +200,29 @@ void resize_to_targets(const RealGarment& rg, const std::vector<std::string>& ta
     // on the hem, 2x-29x on the front and 2x-11x on the back, but 1.0x-1.6x on the
     // side profiles, as eq. 14 holds the surface within 1 cm of body B as warped.
     EXPECT_GT(sum_output_warped, 1.5 * sum_output);
-    // Held-out slices between the profiles: printed, not asserted. Measured 1.3x-2.7x
-    // on the skirt, 0.8x-1.2x on the dress, with or without the zone (the 3x
-    // is not reached: between the features eq. 14 holds most of the tight dress as
-    // warped).
+    // Held-out slices between the profiles. Scored whole, they are dominated by
+    // their part within epsilon of body B, which eq. 14 holds as warped on
+    // purpose (near the body the garment follows the body): on the tight dress
+    // that is 49-60 of 60 samples, and its slices come out 0.8x-1.2x. So the
+    // part the warp leaves at least epsilon off body B (its longest run) is
+    // also scored on its own; that is where the surface is free to follow the
+    // optimised profiles. On the dress it is at most 11 samples at the back
+    // slit (printed only).
     for (std::size_t k = 0; k < held_out.size(); ++k) {
-      const double warp = shape_error(carry(held_out_at[k], r.warped), held_out[k].samples, false);
-      const double out = shape_error(carry(held_out_at[k], r.positions), held_out[k].samples, false);
+      const Points warped = carry(held_out_at[k], r.warped), written = carry(held_out_at[k], r.positions);
+      const Points& original = held_out[k].samples;
+      const double warp = shape_error(warped, original, false), out = shape_error(written, original, false);
       std::printf("[ info ]   held-out %-10s shape error: warp %.5f, written garment %.5f (%.1fx)\n", held_out[k].name.c_str(),
                   warp, out, warp / std::max(out, 1e-12));
+      const auto [first, count] = off_body_run(warped, b_surface, options.surface.epsilon);
+      if (count < 5) continue;
+      const double warp_off = shape_error(warped.middleRows(first, count), original.middleRows(first, count), false);
+      const double out_off = shape_error(written.middleRows(first, count), original.middleRows(first, count), false);
+      std::printf("[ info ]     off the body (samples %ld-%ld): warp %.5f, written garment %.5f (%.1fx)\n", long(first),
+                  long(first + count - 1), warp_off, out_off, warp_off / std::max(out_off, 1e-12));
+      if (held_out_gain > 0.0 && count >= 20) {
+        EXPECT_GT(warp_off, held_out_gain * out_off) << held_out[k].name;
+      }
     }
   }
 }
@@ -206,8 +239,13 @@ const std::vector<std::string> kTargets = {"F_heavier", "F_thinner", "F_taller"}
 TEST(PipelineSharedData, DressToEveryTarget) {
   resize_to_targets({"dress_on_A_female.obj", 5.0, -29.9, -11.5, true}, kTargets, 1, 10.0);
 }
+// The skirt's held-out slices off the body: measured 1.5x-6.3x (the 3x
+// is missed on F_taller, 1.5x and 1.7x, and on F_heavier's back-right, 2.2x: the
+// hip band that eq. 14 holds as warped carries the body's change down the skirt;
+// a feature zone of 3 one-ring steps, which frees the hips too, gives 2.7x-27x
+// but lets the waistband float 0.45 cm (mean) off the thinner body).
 TEST(PipelineSharedData, SkirtToEveryTarget) {
-  resize_to_targets({"skirt_on_A_female.obj", 10.0, -69.6, -69.6, false}, kTargets, 1, 10.0);
+  resize_to_targets({"skirt_on_A_female.obj", 10.0, -69.6, -69.6, false}, kTargets, 1, 10.0, 1.3);
 }
 TEST(PipelineSharedData, TwoLayerOutfit) {
   resize_to_targets({"outfit_dress_jeans_on_A_female.obj", 5.0, -29.9, -11.5, true}, {"F_heavier"}, 1);
