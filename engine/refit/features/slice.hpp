@@ -3,6 +3,7 @@
 // 4.2 and Fig. 3(b)): works on what CAD files hold (faces of any size,
 // non-manifold edges, polygon soups with duplicated coincident vertices).
 #include <refit/core/garment.hpp>
+#include <refit/core/weld.hpp>
 #include <refit/features/plane.hpp>
 
 #include <vector>
@@ -22,16 +23,6 @@ struct SliceResult {
   std::size_t segments = 0;        // face cut segments after welding and removing duplicates
 };
 
-/// Diagonal of the axis-aligned bounding box of the rows (0 when empty).
-double bounding_box_diagonal(const Points& p);
-
-/// Welds points closer than `tolerance` (grid hashing): returns, per row, the index
-/// of its representative: in row order, each point joins the lowest-numbered
-/// representative within `tolerance`, or becomes one (so a cluster's
-/// representative is its first row, and the result is deterministic). Points with
-/// no other point within `tolerance` (most of a garment) are found in parallel
-/// first; only the others go through the sequential clustering. Points must be finite.
-std::vector<Index> weld_points(const Points& p, double tolerance);
 
 /// Cuts the faces of `g` by `plane` and chains the cut segments into polylines.
 /// A vertex exactly on the plane counts as being on the normal's side (so every
