@@ -55,6 +55,7 @@ int run(const ResizeArgs& a) {
     options.surface.smooth_passes = 0;
     options.surface.keep_clear_of_body = false;
     options.surface.feature_zone_rings = 0;  // no zone, no snap
+    options.surface.layers = false;
   }
   options.collision = !a.no_collision;
   options.metrics = a.metrics;
@@ -154,6 +155,9 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
                  "snapped through it (0 = the paper: --epsilon everywhere but on the features)")
       ->capture_default_str()
       ->check(CLI::Range(0, 16));
+  app.add_flag("--no-layers", [a](std::int64_t) { a->surface.layers = false; },
+               "One agent per voxel for the whole garment, as the paper (by default each layer of a multi-layer "
+               "garment gets its own agents, rings and blends)");
   app.add_option("--max-iterations", a->surface.max_iterations, "Gauss-Seidel iterations, at most")->capture_default_str();
   app.add_option("--tolerance", a->surface.tolerance, "Gauss-Seidel stops below this update norm")->capture_default_str();
   app.add_flag("--plain-sweeps", a->plain_sweeps,

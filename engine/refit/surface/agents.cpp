@@ -1,6 +1,7 @@
 #include <refit/body/centre_tree.hpp>
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
+#include <refit/core/weld.hpp>
 #include <refit/surface/agents.hpp>
 
 #include <tbb/parallel_sort.h>
@@ -9,6 +10,8 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <numeric>
+#include <tuple>
 
 namespace refit {
 
@@ -78,8 +81,16 @@ inline std::array<double, 3> lattice_point(std::uint32_t m, std::uint32_t k) {
 struct SampleKey {
   std::uint64_t voxel;
   std::uint64_t rank;  // float bits of squared distance to the voxel centre, then sample number
-  bool operator<(const SampleKey& o) const { return voxel != o.voxel ? voxel < o.voxel : rank < o.rank; }
+  std::uint32_t layer;
+  bool operator<(const SampleKey& o) const {
+    return std::tie(voxel, layer, rank) < std::tie(o.voxel, o.layer, o.rank);
+  }
 };
+
+Index find_root(std::vector<Index>& parent, Index a) {
+  while (parent[a] != a) a = parent[a] = parent[parent[a]];
+  return a;
+}
 }  // namespace
 
 std::array<std::uint32_t, 3> VoxelGrid::cell(const Vec3& p) const {
@@ -164,7 +175,92 @@ VoxelGrid make_voxel_grid(const Garment& g, const Points& extra, double h) {
   return grid;
 }
 
-GarmentAgents select_agents(const Garment& g, const VoxelGrid& grid, const std::vector<std::uint64_t>& skip) {
+std::vector<std::uint32_t> garment_layers(const Garment& g, double min_area, double join_distance) {
+  check_garment(g);
+  const std::size_t n = g.vertex_count();
+  const Points& x = g.positions;
+  std::vector<Index> parent(n);
+  std::iota(parent.begin(), parent.end(), Index{0});
+  const auto unite = [&](Index a, Index b) {
+    a = find_root(parent, a);
+    b = find_root(parent, b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  };
+  for (const Csr* c : {&g.faces, &g.lines, &g.points})
+    for (std::size_t e = 0; e < c->rows(); ++e) {
+      auto r = c->row(e);
+      for (std::size_t k = 1; k < r.size(); ++k) unite(r[0], r[k]);
+    }
+  // Coincident vertices welded only when the faces are in several pieces (most
+  // garments are one: welding a million vertices costs about 50 ms).
+  bool several = false;
+  for (std::size_t f = 1; f < g.faces.rows() && !several; ++f)
+    several = find_root(parent, g.faces.row(f)[0]) != find_root(parent, g.faces.row(0)[0]);
+  std::vector<Index> weld(n);
+  std::iota(weld.begin(), weld.end(), Index{0});
+  if (several) {
+    weld = weld_points(x, 1e-6 * bounding_box_diagonal(x));
+    for (std::size_t v = 0; v < n; ++v) unite(Index(v), weld[v]);
+  }
+  std::vector<double> face_area(g.faces.rows(), 0.0);
+  parallel_for(0, g.faces.rows(), kGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t f = b; f < e; ++f) {
+      auto r = g.faces.row(f);
+      for (std::size_t t = 1; t + 1 < r.size(); ++t)
+        face_area[f] += tri_area(row3(x, r[0]), row3(x, r[t]), row3(x, r[t + 1]));
+    }
+  });
+  const auto piece_area = [&] {
+    std::vector<double> area(n, 0.0);
+    for (std::size_t f = 0; f < g.faces.rows(); ++f) area[find_root(parent, g.faces.row(f)[0])] += face_area[f];
+    return area;
+  };
+  std::vector<double> area = piece_area();
+  const auto is_layer = [&](double a) { return a > 0.0 && a >= min_area; };
+  // Two pieces or more: join those whose face boundaries (edges of one face,
+  // on the welded vertices) come within join_distance of each other.
+  if (join_distance > 0.0 && std::count_if(area.begin(), area.end(), is_layer) >= 2) {
+    std::vector<std::uint64_t> edges;
+    edges.reserve(g.faces.indices.size());
+    for (std::size_t f = 0; f < g.faces.rows(); ++f) {
+      auto r = g.faces.row(f);
+      for (std::size_t k = 0; k < r.size(); ++k) {
+        const std::uint64_t a = weld[r[k]], b = weld[r[(k + 1) % r.size()]];
+        if (a != b) edges.push_back(std::min(a, b) << 32 | std::max(a, b));
+      }
+    }
+    tbb::parallel_sort(edges.begin(), edges.end());
+    std::vector<Index> boundary;
+    for (std::size_t i = 0; i < edges.size();) {
+      std::size_t j = i;
+      while (j < edges.size() && edges[j] == edges[i]) ++j;
+      if (j - i == 1) boundary.insert(boundary.end(), {Index(edges[i] >> 32), Index(edges[i] & 0xffffffffULL)});
+      i = j;
+    }
+    std::sort(boundary.begin(), boundary.end());
+    boundary.erase(std::unique(boundary.begin(), boundary.end()), boundary.end());
+    Points bp(static_cast<Eigen::Index>(boundary.size()), 3);
+    for (std::size_t i = 0; i < boundary.size(); ++i) bp.row(Eigen::Index(i)) = x.row(boundary[i]);
+    const std::vector<Index> near = weld_points(bp, join_distance);
+    for (std::size_t i = 0; i < boundary.size(); ++i) unite(boundary[i], boundary[near[i]]);
+    area = piece_area();
+  }
+  std::vector<std::uint32_t> label(n, 0), of_root(n, 0);
+  std::uint32_t next = 1;
+  for (std::size_t v = 0; v < n; ++v) {
+    const Index r = find_root(parent, Index(v));
+    if (!is_layer(area[r])) continue;
+    if (of_root[r] == 0) of_root[r] = next++;
+    label[v] = of_root[r];
+  }
+  return label;
+}
+
+GarmentAgents select_agents(const Garment& g, const VoxelGrid& grid, const std::vector<VoxelLayer>& skip,
+                            const std::vector<std::uint32_t>& vertex_layer) {
+  if (!vertex_layer.empty() && vertex_layer.size() != g.vertex_count())
+    throw Error("surface: " + std::to_string(vertex_layer.size()) + " vertex layers for " +
+                std::to_string(g.vertex_count()) + " vertices");
   check_garment(g);
   const Points& x = g.positions;
   const double spacing = 0.5 * grid.h;
@@ -239,7 +335,8 @@ GarmentAgents select_agents(const Garment& g, const VoxelGrid& grid, const std::
     const Vec3 p = position(s);
     const auto c = grid.cell(p);
     const float d2 = static_cast<float>((p - grid.centre(c)).squaredNorm());
-    keys[id] = SampleKey{VoxelGrid::morton(c), (std::uint64_t(std::bit_cast<std::uint32_t>(d2)) << 32) | id};
+    keys[id] = SampleKey{VoxelGrid::morton(c), (std::uint64_t(std::bit_cast<std::uint32_t>(d2)) << 32) | id,
+                         vertex_layer.empty() ? 0u : vertex_layer[s.v[0]]};
   };
   parallel_for(0, nv, kGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) key_of(i, Sample{{Index(i), Index(i), Index(i)}, {1.0, 0.0, 0.0}});
@@ -255,10 +352,12 @@ GarmentAgents select_agents(const Garment& g, const VoxelGrid& grid, const std::
   tbb::parallel_sort(keys.begin(), keys.end());
 
   std::vector<std::uint64_t> winners;  // sample numbers
+  std::vector<std::uint32_t> winner_layer;
   for (std::size_t i = 0; i < keys.size(); ++i) {
-    if (i > 0 && keys[i].voxel == keys[i - 1].voxel) continue;
-    if (std::binary_search(skip.begin(), skip.end(), keys[i].voxel)) continue;
+    if (i > 0 && keys[i].voxel == keys[i - 1].voxel && keys[i].layer == keys[i - 1].layer) continue;
+    if (std::binary_search(skip.begin(), skip.end(), VoxelLayer{keys[i].voxel, keys[i].layer})) continue;
     winners.push_back(keys[i].rank & 0xffffffffULL);
+    winner_layer.push_back(keys[i].layer);
   }
   GarmentAgents out;
   out.samples = total;
@@ -266,6 +365,7 @@ GarmentAgents select_agents(const Garment& g, const VoxelGrid& grid, const std::
   out.vertex.resize(na);
   out.weight.resize(na);
   out.voxel.resize(na);
+  out.layer = std::move(winner_layer);
   parallel_for(0, na, kGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t a = b; a < e; ++a) {
       const std::uint64_t id = winners[a];
@@ -288,8 +388,10 @@ GarmentAgents select_agents(const Garment& g, const VoxelGrid& grid, const std::
   return out;
 }
 
-Csr build_one_rings(const Points& agents, double radius) {
+Csr build_one_rings(const Points& agents, double radius, const std::vector<std::uint32_t>& layer) {
   const std::size_t n = static_cast<std::size_t>(agents.rows());
+  if (!layer.empty() && layer.size() != n)
+    throw Error("surface: " + std::to_string(layer.size()) + " agent layers for " + std::to_string(n) + " agents");
   PointTree tree(agents);
   const double r2 = radius * radius;
   const double tiny2 = 1e-18 * r2;
@@ -304,8 +406,9 @@ Csr build_one_rings(const Points& agents, double radius) {
       for (std::size_t k = 0; k < cand.size(); ++k)
         if (cand[k].first == i || cand[k].second <= tiny2) alive[k] = 0;
       std::vector<Index>& ring = rows[i];
+      const std::uint32_t own = layer.empty() ? 0u : layer[i];
       for (std::size_t k = 0; k < cand.size(); ++k) {
-        if (!alive[k]) continue;
+        if (!alive[k] || (own != 0 && layer[cand[k].first] != own)) continue;
         const Vec3 c = row3(agents, cand[k].first);
         ring.push_back(cand[k].first);
         const Vec3 dir = c - a;
@@ -322,6 +425,39 @@ Csr build_one_rings(const Points& agents, double radius) {
     std::vector<Index>().swap(rows[i]);
   }
   return out;
+}
+
+struct LayerTrees::Impl {
+  PointTree all;
+  std::vector<std::unique_ptr<PointTree>> tree;  // per layer (index 0 unused)
+  std::vector<std::vector<Index>> index;         // per layer: the points' indices
+  explicit Impl(const Points& p) : all(p) {}
+};
+
+LayerTrees::LayerTrees(const Points& points, const std::vector<std::uint32_t>& layer) : impl_(std::make_unique<Impl>(points)) {
+  const std::uint32_t layers = layer.empty() ? 0u : *std::max_element(layer.begin(), layer.end());
+  impl_->tree.resize(layers + 1);
+  impl_->index.resize(layers + 1);
+  for (std::size_t i = 0; i < layer.size(); ++i)
+    if (layer[i] > 0) impl_->index[layer[i]].push_back(Index(i));
+  for (std::uint32_t l = 1; l <= layers; ++l) {
+    const std::vector<Index>& ix = impl_->index[l];
+    Points sub(static_cast<Eigen::Index>(ix.size()), 3);
+    for (std::size_t k = 0; k < ix.size(); ++k) sub.row(static_cast<Eigen::Index>(k)) = points.row(ix[k]);
+    impl_->tree[l] = std::make_unique<PointTree>(sub);
+  }
+}
+
+LayerTrees::~LayerTrees() = default;
+
+void LayerTrees::knn(std::uint32_t layer, const Vec3& p, std::size_t k, std::vector<Index>& idx,
+                     std::vector<double>& dist2) const {
+  if (layer == 0 || layer >= impl_->tree.size() || impl_->index[layer].empty()) {
+    impl_->all.knn(p, k, idx, dist2);
+    return;
+  }
+  impl_->tree[layer]->knn(p, k, idx, dist2);
+  for (Index& i : idx) i = impl_->index[layer][i];
 }
 
 }  // namespace refit

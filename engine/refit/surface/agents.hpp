@@ -6,7 +6,10 @@
 #include <refit/core/garment.hpp>
 
 #include <array>
+#include <compare>
 #include <cstdint>
+#include <memory>
+#include <span>
 #include <vector>
 
 namespace refit {
@@ -29,6 +32,7 @@ struct GarmentAgents {
   std::vector<std::array<Index, 3>> vertex;  // the combined vertices
   std::vector<std::array<double, 3>> weight;  // their weights (sum 1)
   std::vector<std::uint64_t> voxel;           // Morton key of the agent's voxel
+  std::vector<std::uint32_t> layer;           // the agent's layer (see garment_layers)
   std::size_t samples = 0;                    // samples considered (vertices + edge + face samples)
 
   std::size_t size() const { return vertex.size(); }
@@ -50,19 +54,58 @@ double auto_voxel_size(const Garment& g, std::size_t agent_budget);
 /// Throws refit::Error when h is not positive and finite or the box needs more than 2^21 voxels per axis.
 VoxelGrid make_voxel_grid(const Garment& g, const Points& extra, double h);
 
+/// Layers of a garment (beyond the paper, which samples all of a garment into
+/// one voxel grid: where two layers lie closer than a voxel, such as a dress
+/// over trousers or a slip, a voxel's one agent stands on either, and each
+/// layer follows the other's motion). The pieces of the garment's faces, lines
+/// and points, connected through shared vertices after welding coincident ones
+/// (1e-6 of the bounding box diagonal: soups and split seams stay one piece),
+/// and pieces whose face boundaries come within `join_distance` of each other
+/// (panels cut apart with a small gap between them) joined; a piece whose face
+/// area is at least `min_area` is a layer, numbered 1, 2, ... in the order of
+/// its first vertex. Everything else (points, hanging lines, small pieces,
+/// unreferenced vertices) is layer 0, "loose": it belongs to no layer and
+/// moves with whatever surface is near it. Per vertex.
+std::vector<std::uint32_t> garment_layers(const Garment& g, double min_area, double join_distance);
+
+/// A voxel of one layer.
+struct VoxelLayer {
+  std::uint64_t voxel = 0;  // Morton key
+  std::uint32_t layer = 0;
+  auto operator<=>(const VoxelLayer&) const = default;
+};
+
 /// Samples every vertex, every `l` segment by length and every face (fan
 /// triangles) by area at spacing about h/2, all on the positions of `g`, and
-/// keeps per voxel the sample nearest the voxel centre (ties: the lower sample
-/// number). Voxels listed in `skip_voxels` (sorted Morton keys, for example
-/// those of feature agents) get no garment agent. Agents come out in Morton
-/// order of their voxels. Parallel and deterministic.
-GarmentAgents select_agents(const Garment& g, const VoxelGrid& grid, const std::vector<std::uint64_t>& skip_voxels = {});
+/// keeps per voxel and layer (`vertex_layer`, per vertex; empty: all layer 0)
+/// the sample nearest the voxel centre (ties: the lower sample number). Pairs
+/// listed in `skip` (sorted; for example those of feature agents) get no
+/// garment agent. Agents come out in Morton order of their voxels, then by
+/// layer. Parallel and deterministic.
+GarmentAgents select_agents(const Garment& g, const VoxelGrid& grid, const std::vector<VoxelLayer>& skip = {},
+                            const std::vector<std::uint32_t>& vertex_layer = {});
 
 /// One-ring of every point (section 5.1): repeatedly take the nearest remaining
 /// candidate a_c within `radius` as a neighbour and drop every candidate p with
 /// (p - a_c).(a_c - a) >= 0. Candidates closer than 1e-9 * radius (coincident
 /// points) are ignored. Rows are in the order found (nearest first). Parallel,
 /// deterministic.
-Csr build_one_rings(const Points& agents, double radius);
+///
+/// With `layer` (per point; see garment_layers), a point of a layer takes
+/// candidates of its own layer only; a loose point (layer 0) takes any.
+Csr build_one_rings(const Points& agents, double radius, const std::vector<std::uint32_t>& layer = {});
+
+/// k nearest points of the same layer (loose queries: of any layer).
+class LayerTrees {
+ public:
+  LayerTrees(const Points& points, const std::vector<std::uint32_t>& layer);
+  ~LayerTrees();
+  /// The k nearest points of layer `layer` (0: of all), closest first, as indices into the points.
+  void knn(std::uint32_t layer, const Vec3& p, std::size_t k, std::vector<Index>& idx, std::vector<double>& dist2) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace refit

@@ -73,10 +73,11 @@ struct Ordered {
   Csr ring;
   double width = 0.0;
 };
-Ordered order_agents(const Points& natural, const std::vector<std::uint64_t>& morton, double radius, double min_width) {
+Ordered order_agents(const Points& natural, const std::vector<std::uint64_t>& morton, const std::vector<std::uint32_t>& layer,
+                     double radius, double min_width) {
   Ordered o;
   const std::size_t n = static_cast<std::size_t>(natural.rows());
-  const Csr ring0 = build_one_rings(natural, radius);
+  const Csr ring0 = build_one_rings(natural, radius, layer);
   // Wider than the longest edge keeps same-colour blocks apart; a few voxels wide
   // gives each parallel task enough agents to pay for itself.
   o.width = std::max(longest_edge(natural, ring0) * (1.0 + 1e-6), min_width);
@@ -92,11 +93,13 @@ Ordered order_agents(const Points& natural, const std::vector<std::uint64_t>& mo
   return o;
 }
 
-// Per point of `fine`: its k nearest points of `coarse` with normalised inverse
-// squared distance weights (a point on a coarse one gets all the weight).
-void interpolation(const Points& fine, const Points& coarse, std::size_t k, double tiny, Csr& out,
+// Per point of `fine`: its k nearest points of `coarse` of the same layer (see
+// LayerTrees) with normalised inverse squared distance weights (a point on a
+// coarse one gets all the weight).
+void interpolation(const Points& fine, const std::vector<std::uint32_t>& fine_layer, const Points& coarse,
+                   const std::vector<std::uint32_t>& coarse_layer, std::size_t k, double tiny, Csr& out,
                    std::vector<float>& weight) {
-  const PointTree tree(coarse);
+  const LayerTrees tree(coarse, coarse_layer);
   const std::size_t n = static_cast<std::size_t>(fine.rows());
   out.offsets.assign(n + 1, 0);
   std::vector<Index> cnt(n, 0);
@@ -107,7 +110,7 @@ void interpolation(const Points& fine, const Points& coarse, std::size_t k, doub
     std::vector<Index> idx;
     std::vector<double> d2;
     for (std::size_t i = b; i < e; ++i) {
-      tree.knn(row3(fine, Index(i)), k, idx, d2);
+      tree.knn(fine_layer.empty() ? 0u : fine_layer[i], row3(fine, Index(i)), k, idx, d2);
       double sum = 0.0;
       std::array<double, 8> w{};
       for (std::size_t j = 0; j < idx.size(); ++j) sum += w[j] = 1.0 / (d2[j] + tiny);
@@ -150,15 +153,36 @@ SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, co
   st.voxel = s.h_;
   const VoxelGrid grid = make_voxel_grid(g, features, s.h_);
   const std::size_t nf = static_cast<std::size_t>(features.rows());
+  const std::size_t nv = g.vertex_count();
+  // Feature samples move with the garment where they sit (when they have no
+  // warped position) and belong to its layer there.
+  if (nf > 0 && nv > 0) {
+    if (feature_attachment && feature_attachment->vertex.size() != nf)
+      throw Error("surface: the feature attachment has " + std::to_string(feature_attachment->vertex.size()) +
+                  " samples, the features " + std::to_string(nf));
+    s.feature_attachment_ = feature_attachment ? *feature_attachment : attach_points(g, features);
+  }
+  const std::vector<std::uint32_t> vertex_layer =
+      options.layers ? garment_layers(g, options.layer_min_area * s.h_ * s.h_, options.layer_join * s.h_) : std::vector<std::uint32_t>{};
+  std::vector<std::uint32_t> feature_layer(nf, 0);
+  if (!vertex_layer.empty() && !s.feature_attachment_.vertex.empty())
+    for (std::size_t k = 0; k < nf; ++k) {
+      const auto& w = s.feature_attachment_.weight[k];
+      const int j = int(std::max_element(w.begin(), w.end()) - w.begin());
+      feature_layer[k] = vertex_layer[s.feature_attachment_.vertex[k][j]];
+    }
   std::vector<std::uint64_t> feature_voxel(nf);
-  for (std::size_t k = 0; k < nf; ++k) feature_voxel[k] = VoxelGrid::morton(grid.cell(row3(features, Index(k))));
-  std::vector<std::uint64_t> skip = feature_voxel;
+  std::vector<VoxelLayer> skip(nf);
+  for (std::size_t k = 0; k < nf; ++k) {
+    feature_voxel[k] = VoxelGrid::morton(grid.cell(row3(features, Index(k))));
+    skip[k] = {feature_voxel[k], feature_layer[k]};
+  }
   std::sort(skip.begin(), skip.end());
   skip.erase(std::unique(skip.begin(), skip.end()), skip.end());
   st.ms.sample = clock.ms();
   clock.reset();
 
-  GarmentAgents ga = select_agents(g, grid, skip);
+  GarmentAgents ga = select_agents(g, grid, skip, vertex_layer);
   const std::size_t ng = ga.size(), n = ng + nf;
   st.samples = ga.samples;
   st.garment_agents = ng;
@@ -169,10 +193,13 @@ SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, co
   if (nf > 0) natural.bottomRows(static_cast<Eigen::Index>(nf)) = features;
   std::vector<std::uint64_t> morton = ga.voxel;
   morton.insert(morton.end(), feature_voxel.begin(), feature_voxel.end());
+  std::vector<std::uint32_t> natural_layer = ga.layer;
+  natural_layer.insert(natural_layer.end(), feature_layer.begin(), feature_layer.end());
+  st.layers = vertex_layer.empty() ? 0 : *std::max_element(vertex_layer.begin(), vertex_layer.end());
   st.ms.agents = clock.ms();
   clock.reset();
 
-  Ordered ord = order_agents(natural, morton, options.ring_radius_voxels * s.h_, options.block_voxels * s.h_);
+  Ordered ord = order_agents(natural, morton, natural_layer, options.ring_radius_voxels * s.h_, options.block_voxels * s.h_);
   const std::vector<Index>& order = ord.order;
   const double width = ord.width;
   s.ring_ = std::move(ord.ring);
@@ -181,9 +208,11 @@ SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, co
   s.src_weight_.resize(n);
   s.feature_of_.assign(n, -1);
   s.feature_slot_.resize(nf);
+  s.layer_.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
     const Index old = order[k];
     s.original_agents_.row(static_cast<Eigen::Index>(k)) = natural.row(old);
+    s.layer_[k] = natural_layer[old];
     if (old < ng) {
       s.src_vertex_[k] = ga.vertex[old];
       s.src_weight_[k] = ga.weight[old];
@@ -244,46 +273,53 @@ SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, co
     cg.origin = pf.colwise().minCoeff().transpose();
     struct Key {
       std::uint64_t voxel;
+      std::uint32_t layer;
       int garment;  // 0: feature agent (always kept)
       double d2;
       Index k;
       bool operator<(const Key& o) const {
-        return std::tie(voxel, garment, d2, k) < std::tie(o.voxel, o.garment, o.d2, o.k);
+        return std::tie(voxel, layer, garment, d2, k) < std::tie(o.voxel, o.layer, o.garment, o.d2, o.k);
       }
     };
     std::vector<Key> keys(nfin);
+    std::vector<std::uint32_t> finer_layer(nfin);
     for (std::size_t k = 0; k < nfin; ++k) {
       const Vec3 p = row3(pf, Index(k));
       const auto c = cg.cell(p);
-      keys[k] = Key{VoxelGrid::morton(c), s.feature_of_[finer_agents[k]] >= 0 ? 0 : 1, (p - cg.centre(c)).squaredNorm(),
-                    Index(k)};
+      finer_layer[k] = s.layer_[finer_agents[k]];
+      keys[k] = Key{VoxelGrid::morton(c), finer_layer[k], s.feature_of_[finer_agents[k]] >= 0 ? 0 : 1,
+                    (p - cg.centre(c)).squaredNorm(), Index(k)};
     }
     std::sort(keys.begin(), keys.end());
     std::vector<Index> kept;  // indices into finer_agents
     std::vector<std::uint64_t> kept_voxel;
+    std::vector<std::uint32_t> kept_layer;
     for (std::size_t i = 0; i < nfin; ++i) {
-      const bool first = i == 0 || keys[i].voxel != keys[i - 1].voxel;
+      const bool first = i == 0 || keys[i].voxel != keys[i - 1].voxel || keys[i].layer != keys[i - 1].layer;
       if (keys[i].garment == 0 || (first)) {
         kept.push_back(keys[i].k);
         kept_voxel.push_back(keys[i].voxel);
+        kept_layer.push_back(keys[i].layer);
       }
     }
     if (kept.size() * 4 > nfin * 3) break;  // hardly coarser: no use
     Points natural_l(static_cast<Eigen::Index>(kept.size()), 3);
     for (std::size_t i = 0; i < kept.size(); ++i) natural_l.row(Eigen::Index(i)) = pf.row(kept[i]);
-    Ordered ol = order_agents(natural_l, kept_voxel, options.ring_radius_voxels * hl, options.block_voxels * hl);
+    Ordered ol = order_agents(natural_l, kept_voxel, kept_layer, options.ring_radius_voxels * hl, options.block_voxels * hl);
     Level lv;
     lv.agent.resize(kept.size());
     Points pos(static_cast<Eigen::Index>(kept.size()), 3);
+    std::vector<std::uint32_t> pos_layer(kept.size());
     for (std::size_t i = 0; i < kept.size(); ++i) {
       lv.agent[i] = finer_agents[kept[ol.order[i]]];
       pos.row(Eigen::Index(i)) = natural_l.row(ol.order[i]);
+      pos_layer[i] = kept_layer[ol.order[i]];
     }
     lv.rows = encode_agents(pos, ol.ring);
     lv.ring = lv.rows.ring;
     lv.schedule = make_schedule(pos, lv.ring, ol.width);
     lv.group = ring_groups(lv.ring);
-    interpolation(pf, pos, 4, 1e-12 * hl * hl, lv.up, lv.up_weight);
+    interpolation(pf, finer_layer, pos, pos_layer, 4, 1e-12 * hl * hl, lv.up, lv.up_weight);
     finer_agents = lv.agent;
     s.levels_.push_back(std::move(lv));
   }
@@ -293,11 +329,11 @@ SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, co
 
   // Each vertex's nearest agents within reach (a bounded k-nearest query), and the
   // nearest agent (for vertices with none).
-  const std::size_t nv = g.vertex_count();
   const std::size_t kmax = options.max_reach_agents;
   s.nearest_.assign(nv, 0);
   if (n > 0) {
-    const PointTree tree(s.original_agents_);
+    // A vertex of a layer blends its own layer's agents only.
+    const LayerTrees tree(s.original_agents_, s.layer_);
     const double reach2 = std::pow(options.reach_voxels * s.h_, 2);
     std::vector<std::uint8_t> capped(nv, 0);
     std::vector<std::uint8_t> count(nv, 0);
@@ -308,7 +344,7 @@ SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, co
       std::vector<double> d2;
       for (std::size_t v = b; v < e; ++v) {
         const Vec3 p = row3(g.positions, Index(v));
-        tree.knn(p, kmax + 1, idx, d2);
+        tree.knn(vertex_layer.empty() ? 0u : vertex_layer[v], p, kmax + 1, idx, d2);
         std::size_t m = 0;
         while (m < idx.size() && m < kmax && d2[m] < reach2) ++m;
         capped[v] = m == kmax && idx.size() > m && d2[m] < reach2;
@@ -350,13 +386,6 @@ SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, co
     });
     st.vertices_capped = std::accumulate(capped.begin(), capped.end(), std::size_t{0});
     for (std::size_t v = 0; v < nv; ++v) st.vertices_without_agent += count[v] == 0;
-    // Feature samples without a warped position move with the garment where they sit.
-    if (nf > 0 && nv > 0) {
-      if (feature_attachment && feature_attachment->vertex.size() != nf)
-        throw Error("surface: the feature attachment has " + std::to_string(feature_attachment->vertex.size()) +
-                    " samples, the features " + std::to_string(nf));
-      s.feature_attachment_ = feature_attachment ? *feature_attachment : attach_points(g, features);
-    }
   } else {
     s.reach_.offsets.assign(nv + 1, 0);
   }
@@ -769,6 +798,44 @@ SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
     tight = true;
     solve_fine(solve);
   }
+  // Beyond the paper: an anchored agent (its group has nothing fixed: a layer
+  // of its own with no feature and nowhere near body B, such as a loose
+  // overskirt over a fitted one) moves with the step's correction of the solved
+  // agents within reach (inverse squared distance blend of the 4 nearest), so
+  // it keeps to the layer beneath instead of staying where the warp put it;
+  // one with none within reach stays as warped.
+  std::vector<std::uint8_t> anchored_kept(n, 0);
+  if (st.anchored > 0) {
+    std::vector<std::uint8_t> solved(n, 0);
+    for (std::size_t a = 0; a < n; ++a) {
+      solved[a] = fixed[a] || fr[a];
+      anchored_kept[a] = !solved[a];
+    }
+    if (std::count(solved.begin(), solved.end(), 1) > 0) {
+      const PointTree tree(before, solved);
+      const double reach2 = std::pow(options_.reach_voxels * h_, 2);
+      const Points correction = x - before;
+      parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
+        std::vector<Index> idx;
+        std::vector<double> d2;
+        for (std::size_t a = b; a < e; ++a) {
+          if (solved[a]) continue;
+          tree.knn(row3(before, Index(a)), 4, idx, d2);
+          Vec3 c = Vec3::Zero();
+          double sum = 0.0;
+          for (std::size_t j = 0; j < idx.size() && d2[j] < reach2; ++j) {
+            const double w = 1.0 / (d2[j] + 1e-12 * reach2);
+            c += w * row3(correction, idx[j]);
+            sum += w;
+          }
+          if (sum == 0.0) continue;
+          x.row(Eigen::Index(a)) += (c / sum).transpose();
+          anchored_kept[a] = 0;
+        }
+      });
+    }
+    for (std::size_t a = 0; a < n; ++a) st.anchored_followed += !fixed[a] && !fr[a] && !anchored_kept[a];
+  }
   // Beyond the paper: the solution on irregular agents carries agent-scale noise
   // in its displacement (each h is exact only for its own original ring), which
   // the reconstruction shows as waviness. A few Jacobi passes move each free
@@ -802,7 +869,7 @@ SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
     // body's triangles change) is then replaced by the garment's original detail,
     // which is what this step restores; coarser warp changes live in the agents.
     // With encode_on_warped the target shape is the warp's, so its detail stays.
-    // Anchored agents did not move: they hand their vertices back as warped.
+    // Anchored agents that had no solved agent within reach hand their vertices back as warped.
     const bool orig = options_.emit_from_original && !options_.encode_on_warped;
     const Points& from = orig ? original_agents_ : before;
     std::vector<Eigen::Matrix3d> rot;
@@ -812,10 +879,7 @@ SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
       rot = frame_rotations(agent_frames(from, ring_, ring_open_, flip_), agent_frames(x, ring_, ring_open_, flip_));
     }
     std::vector<std::uint8_t> keep;
-    if (orig && st.anchored > 0) {
-      keep.assign(n, 0);
-      for (std::size_t a = 0; a < n; ++a) keep[a] = !fixed[a] && !fr[a];
-    }
+    if (orig && st.anchored > st.anchored_followed) keep = anchored_kept;
     res.positions = reconstruct_rotations(orig ? original_vertices_ : warped, from, x, rot, reach_, reach_weight_,
                                           nearest_, keep, &warped);
   }

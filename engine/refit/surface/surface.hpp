@@ -57,6 +57,10 @@ struct SurfaceOptions {
   int coarsest_sweeps = 50;        // sweeps of the coarsest correction
   double multigrid_overcorrection = 1.5;  // aggregation's usual factor on each coarse correction (measured on the 40k
                                           // demo dress: 164 fine sweeps to the 1e-5 update with 1.0, 82 with 1.5)
+  bool layers = true;              // beyond the paper: one agent per voxel and layer, rings and blends within a layer
+                                   // (see garment_layers; false: the paper's one agent per voxel for the whole garment)
+  double layer_min_area = 8.0;     // a piece is a layer from this face area on, in voxel areas (h^2)
+  double layer_join = 0.1;         // pieces whose face boundaries come this close (in voxels) are one layer
   // Beyond the paper (each documented where it is used; false gives the paper's way):
   bool rotate_encoding = false;    // turn each h (eq. 12) with the agent's ring rotation from the original to the warp (measured worse: see apply)
   bool fit_rotations = true;       // frames as least-squares ring rotations instead of fan normal + one-neighbour tangent
@@ -74,6 +78,7 @@ struct SurfaceTimings {
 
 struct SurfaceStats {
   std::size_t agents = 0, garment_agents = 0, feature_agents = 0, samples = 0;
+  std::uint32_t layers = 0;  // layers of the garment (0 without layers; see SurfaceOptions::layers)
   double voxel = 0.0;
   bool voxel_was_auto = false;
   double ring_degree_mean = 0.0;
@@ -84,7 +89,8 @@ struct SurfaceStats {
   std::size_t fixed_body = 0, fixed_feature = 0;
   std::size_t fixed_clearance = 0;  // agents the solve left closer than the clearance to body B, then held at it
   int clearance_rounds = 0;         // re-solves after adding such agents
-  std::size_t anchored = 0, anchored_groups = 0;  // agents (and their groups) with no fixed agent, held at their warped positions
+  std::size_t anchored = 0, anchored_groups = 0;  // agents (and their groups) with no fixed agent
+  std::size_t anchored_followed = 0;  // of those, moved with solved agents within reach (the rest stay as warped)
   int iterations = 0;
   double final_update = 0.0;
   bool converged = false;
@@ -184,6 +190,7 @@ class SurfaceBinding {
   std::vector<std::uint8_t> near_feature_;     // per agent: in the features' zone (empty without a zone)
   std::vector<std::uint8_t> carries_feature_;  // per vertex: a corner of a face a feature sample sits on (with a zone)
   std::vector<Index> feature_slot_;
+  std::vector<std::uint32_t> layer_;      // per agent (storage order): its layer (all 0 without layers)
   SurfaceAttachment feature_attachment_;  // where each feature sample sits on the original garment
   Points original_agents_;
   Csr ring_;                         // angular order (see order_rings)
