@@ -24,12 +24,13 @@ using test::run_cli;
 struct Case {
   test::TempDir dir;
   std::string a, b, garment, features;
-  Case(std::size_t vertices = 6000) {
+  Case(std::size_t vertices = 6000, bool two_layers = false) {
     mannequin::BodyParams pa, pb;
     pb.belly = 6;
     pb.hip = 104;
     mannequin::GarmentParams g;
     g.target_vertices = vertices;
+    g.two_layers = two_layers;
     a = dir.file("A.obj");
     b = dir.file("B.obj");
     garment = dir.file("dress.obj");
@@ -66,8 +67,23 @@ TEST(Cli, ResizeWritesOutputAndReport) {
   for (const char* key : {"load", "warp", "write", "total", "features", "surface"})
     EXPECT_TRUE(j["timings_ms"].contains(key)) << key;
   EXPECT_EQ(j["features"].size(), 5u);
-  for (const char* key : {"agents", "voxel", "fixed_body", "fixed_feature", "anchored", "iterations", "final_update"})
+  for (const char* key : {"agents", "layers", "voxel", "fixed_body", "fixed_feature", "anchored", "anchored_followed",
+                          "iterations", "final_update"})
     EXPECT_TRUE(j["surface"].contains(key)) << key;
+}
+
+TEST(Cli, LayersAreReportedAndNoLayersGivesThePapersSampling) {
+  const Case c(8000, true);  // the dress over a slip
+  const std::string feats = "--features '" + c.features + "' ";
+  const std::string with = c.dir.file("with.obj"), without = c.dir.file("without.obj");
+  const std::string rw = c.dir.file("with.json"), rn = c.dir.file("without.json");
+  ASSERT_EQ(run_cli(c.resize(with, feats + "--report '" + rw + "'")).exit_code, 0);
+  ASSERT_EQ(run_cli(c.resize(without, feats + "--no-layers --report '" + rn + "'")).exit_code, 0);
+  const auto jw = nlohmann::json::parse(test::read_text(rw)), jn = nlohmann::json::parse(test::read_text(rn));
+  EXPECT_EQ(jw["surface"]["layers"], 2);
+  EXPECT_EQ(jn["surface"]["layers"], 0);
+  EXPECT_GT(jw["surface"]["agents"].get<std::size_t>(), jn["surface"]["agents"].get<std::size_t>());
+  EXPECT_GT((read_garment_obj(with).positions - read_garment_obj(without).positions).cwiseAbs().maxCoeff(), 1e-3);
 }
 
 TEST(Cli, OneAndTwoThreadsWriteIdenticalBytes) {
