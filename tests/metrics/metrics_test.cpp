@@ -214,20 +214,24 @@ TEST(Collision, PushedTopComesOutSmoothlyAndOnlyLocally) {
   EXPECT_EQ(measure_sanity(pushed_garment, out).flipped_faces, 0u);
   EXPECT_LE(measure_sanity(p.garment, out).flipped_faces, measure_sanity(p.garment, p.pushed).flipped_faces);
 
-  // Untouched: vertices beyond the clearance and more than smoothing_rings edges
-  // from any too-close vertex keep their exact position; everything that moved
-  // is within those rings.
+  // Untouched: vertices more than smoothing_rings edges from any too-close
+  // vertex (inside or within the clearance, or a corner of a face whose centre
+  // is) keep their exact position; everything that moved is within those rings.
   const Csr adj = vertex_adjacency(p.garment);
   const std::size_t n = p.garment.vertex_count();
   std::vector<int> ring(n, -1);
   std::vector<Index> frontier;
-  for (Index i = 0; i < n; ++i) {
-    const Vec3 q = row3(p.pushed, i);
-    if (body.inside(q) || body.closest(q).distance < o.clearance) {
-      ring[i] = 0;
-      frontier.push_back(i);
-    }
+  const auto too_close = [&](const Vec3& q) { return body.inside(q) || body.closest(q).distance < o.clearance; };
+  for (Index i = 0; i < n; ++i)
+    if (too_close(row3(p.pushed, i))) ring[i] = 0;
+  for (std::size_t f = 0; f < p.garment.faces.rows(); ++f) {
+    Vec3 centre = Vec3::Zero();
+    for (Index v : p.garment.faces.row(f)) centre += row3(p.pushed, v);
+    if (too_close(centre / double(p.garment.faces.row_size(f))))
+      for (Index v : p.garment.faces.row(f)) ring[v] = 0;
   }
+  for (Index i = 0; i < n; ++i)
+    if (ring[i] == 0) frontier.push_back(i);
   for (int level = 1; level <= o.smoothing_rings; ++level) {
     std::vector<Index> next;
     for (Index i : frontier)
@@ -265,6 +269,38 @@ TEST(Collision, PushedTopComesOutSmoothlyAndOnlyLocally) {
   EXPECT_EQ(none.too_close, 0u);
   EXPECT_EQ(none.moved, 0u);
   EXPECT_TRUE(designed == p.garment.positions);
+}
+
+TEST(Collision, TheBodyPokingThroughACoarseFaceIsPushedOutToo) {
+  // A flat 5 x 5 grid of 4 cm quads at y = 9.8 over a sphere of radius 10: the
+  // corners nearest its top, (+-2, +-2), clear the body by about 0.2 (more than
+  // the clearance, 0.1), but the sphere's top pokes through the middle face.
+  const BodySurface body(sphere_body(4, 10.0));
+  Garment g;
+  g.positions.resize(36, 3);
+  for (int i = 0; i < 6; ++i)
+    for (int k = 0; k < 6; ++k) g.positions.row(i * 6 + k) << -10.0 + 4.0 * i, 9.8, -10.0 + 4.0 * k;
+  for (int i = 0; i < 5; ++i)
+    for (int k = 0; k < 5; ++k) {
+      const Index a = Index(i * 6 + k);
+      g.faces.push_row(std::array<Index, 4>{a, a + 1, a + 7, a + 6});
+    }
+  CollisionOptions o;
+  o.clearance = 0.1;
+  Points out = g.positions;
+  ASSERT_EQ(measure_penetration(out, body).inside, 0u);
+  for (Index v = 0; v < 36; ++v) ASSERT_GT(body.closest(row3(out, v)).distance, o.clearance) << v;
+  ASSERT_EQ(count_face_centres_inside(g, out, body), 1u);
+  const CollisionReport r = resolve_penetrations(g, out, body, o);
+  EXPECT_EQ(r.too_close, 0u);  // no vertex of its own
+  EXPECT_EQ(r.face_centres_inside_before, 1u);
+  EXPECT_EQ(r.face_centres_inside_after, 0u);
+  EXPECT_EQ(count_face_centres_inside(g, out, body), 0u);
+  // The middle face's centre clears the body by the clearance now.
+  Vec3 centre = Vec3::Zero();
+  for (Index v : g.faces.row(12)) centre += row3(out, v);
+  EXPECT_GE(body.closest(centre / 4.0).distance, o.clearance * 0.99);
+  EXPECT_GT(r.moved, 4u);
 }
 
 TEST(Collision, SphereShellPartlyInsideComesOutBitIdenticalForAnyThreadCount) {

@@ -1,8 +1,8 @@
 #pragma once
 // Penetration resolution (beyond the paper; runs after the surface step): garment
-// vertices inside body B or closer than a clearance move out along the body's
-// closest-point normal, and the correction is spread smoothly over their
-// neighbours so no spikes appear.
+// vertices inside body B or closer than a clearance, and the corners of faces
+// whose centre is, move out along the body's closest-point normal, and the
+// correction is spread smoothly over their neighbours so no spikes appear.
 #include <refit/body/body_surface.hpp>
 #include <refit/core/garment.hpp>
 
@@ -25,6 +25,8 @@ struct CollisionReport {
   double max_displacement = 0.0;
   double mean_displacement = 0.0;  // over the moved vertices
   std::size_t inside_after = 0;
+  std::size_t face_centres_inside_before = 0;  // faces whose centre is inside the body (the body poking through)
+  std::size_t face_centres_inside_after = 0;
   int rounds = 0;
 
   nlohmann::json to_json() const;
@@ -37,6 +39,9 @@ struct CollisionReport {
 /// positions and garment differ in vertex count or the clearance is negative.
 CollisionReport resolve_penetrations(const Garment& g, Points& positions, const BodySurface& body_b,
                                      const CollisionOptions& options = {});
+
+/// Faces (3 corners or more) whose centre (corner mean) is inside `body`. Parallel.
+std::size_t count_face_centres_inside(const Garment& g, const Points& positions, const BodySurface& body);
 
 /// Vertex adjacency (CSR, sorted, no duplicates) from faces and `l` lines.
 Csr vertex_adjacency(const Garment& g);
