@@ -2,7 +2,7 @@
 // data: the dress and the skirt to every target body, and the two-layer outfit,
 // with the hem and four side profiles as features. Skips when ../shared/data is
 // absent. Asserts what holds today (every vertex written, no NaN, no more
-// vertices inside body B than the warp alone leaves, the written garment keeps
+// vertices inside body B than the warp alone leaves and no face centre, the written garment keeps
 // every curve no worse and all together better than the warp, the skirt's
 // held-out slices between the profiles better than the warp where they stand
 // off the body) and prints the shape errors.
@@ -172,9 +172,13 @@ void resize_to_targets(const RealGarment& rg, const std::vector<std::string>& ta
     const auto& m = r.report.at("metrics");
     const std::size_t inside_warp = m.at("warp").at("penetration").at("inside");
     const std::size_t inside_result = m.at("result").at("penetration").at("inside");
-    std::printf("[ info ] %s -> %s: vertices inside body B: warp %zu, result %zu\n", rg.file, target.c_str(),
-                inside_warp, inside_result);
+    const std::size_t centres_warp = m.at("warp").at("penetration").at("face_centres_inside");
+    const std::size_t centres_result = m.at("result").at("penetration").at("face_centres_inside");
+    std::printf("[ info ] %s -> %s: vertices inside body B: warp %zu, result %zu; face centres inside: warp %zu, result %zu\n",
+                rg.file, target.c_str(), inside_warp, inside_result, centres_warp, centres_result);
     EXPECT_LE(inside_result, inside_warp);
+    // The body poking through the middle of coarse faces is pushed out too.
+    EXPECT_EQ(centres_result, 0u);
     double sum_output_warped = 0.0, sum_output = 0.0;
     for (const auto& f : r.report.at("features")) {
       const double warped = f.at("shape_error_warped"), curve = f.at("shape_error_result"), output = f.at("shape_error_output");

@@ -1,3 +1,4 @@
+#include <refit/metrics/collision.hpp>
 #include <refit/metrics/metrics.hpp>
 
 #include <refit/body/centre_tree.hpp>
@@ -195,6 +196,7 @@ ResizeMetrics compute_metrics(const Garment& original, const Points& result, con
   m.vertices = static_cast<std::size_t>(result.rows());
   m.fit = measure_fit(original.positions, result, a, b, options.fit_band);
   m.penetration = measure_penetration(result, b);
+  m.penetration.face_centres_inside = count_face_centres_inside(original, result, b);
   m.sanity = measure_sanity(original, result);
   for (const auto& c : options.features) {
     if (c.result.rows() != c.original.rows() || (c.warped.rows() != 0 && c.warped.rows() != c.original.rows()))
@@ -248,7 +250,8 @@ nlohmann::json ResizeMetrics::to_json() const {
                       {"checked", penetration.checked},
                       {"fraction", penetration.fraction},
                       {"deepest", penetration.deepest},
-                      {"deepest_vertex", penetration.deepest_vertex}};
+                      {"deepest_vertex", penetration.deepest_vertex},
+                      {"face_centres_inside", penetration.face_centres_inside}};
   j["sanity"] = {{"nan_vertices", sanity.nan_vertices},
                  {"faces_checked", sanity.faces_checked},
                  {"flipped_faces", sanity.flipped_faces},

@@ -35,6 +35,7 @@ struct PenetrationMetrics {
   double fraction = 0.0;        // inside / checked
   double deepest = 0.0;         // distance to the surface of the deepest inside vertex
   long deepest_vertex = -1;     // its index, -1 when none
+  std::size_t face_centres_inside = 0;  // faces whose centre is inside (the body poking through; compute_metrics only)
 };
 
 /// Surface sanity of the result against the original.
