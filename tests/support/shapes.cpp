@@ -41,4 +41,40 @@ BodyMesh icosphere(int levels, double radius, const Vec3& centre) {
   return m;
 }
 
+Garment quad_grid(int nx, int nz, double s, const std::function<double(double, double)>& height, double x0, double z0) {
+  Garment g;
+  g.positions.resize(nx * nz, 3);
+  for (int i = 0; i < nx; ++i)
+    for (int k = 0; k < nz; ++k) {
+      const double x = x0 + i * s, z = z0 + k * s;
+      g.positions.row(i * nz + k) << x, height(x, z), z;
+    }
+  for (int i = 0; i + 1 < nx; ++i)
+    for (int k = 0; k + 1 < nz; ++k) {
+      const Index a = Index(i * nz + k);
+      const std::array<Index, 4> q{a, a + 1, a + 1 + Index(nz), a + Index(nz)};
+      g.faces.push_row(q);
+    }
+  return g;
+}
+
+Garment merge_garments(const Garment& a, const Garment& b) {
+  Garment g;
+  g.positions.resize(a.positions.rows() + b.positions.rows(), 3);
+  g.positions << a.positions, b.positions;
+  const Index base = Index(a.vertex_count());
+  const auto append = [&](const Csr& from_a, const Csr& from_b, Csr& out) {
+    out = from_a;
+    for (std::size_t e = 0; e < from_b.rows(); ++e) {
+      std::vector<Index> r(from_b.row(e).begin(), from_b.row(e).end());
+      for (Index& v : r) v += base;
+      out.push_row(r);
+    }
+  };
+  append(a.faces, b.faces, g.faces);
+  append(a.lines, b.lines, g.lines);
+  append(a.points, b.points, g.points);
+  return g;
+}
+
 }  // namespace refit::test

@@ -1,6 +1,8 @@
 // Layers in the surface step (beyond the paper): pieces of a garment lying over
 // each other closer than a voxel get agents, rings and blends of their own, and
 // a layer with nothing fixed moves with the layer beneath.
+#include "support/shapes.hpp"
+
 #include <refit/surface/agents.hpp>
 #include <refit/surface/surface.hpp>
 
@@ -14,41 +16,9 @@ namespace {
 
 // An n x n quad grid of spacing s on y = y0 + wave * sin(1.7 x), from (x0, z0).
 Garment sheet(int n, double s, double y0, double x0 = 0.0, double z0 = 0.0, double wave = 0.0) {
-  Garment g;
-  g.positions.resize(n * n, 3);
-  for (int i = 0; i < n; ++i)
-    for (int k = 0; k < n; ++k) {
-      const double x = x0 + i * s;
-      g.positions.row(i * n + k) << x, y0 + wave * std::sin(1.7 * x), z0 + k * s;
-    }
-  for (int i = 0; i + 1 < n; ++i)
-    for (int k = 0; k + 1 < n; ++k) {
-      const Index a = Index(i * n + k);
-      const std::array<Index, 4> q{a, a + 1, a + 1 + Index(n), a + Index(n)};
-      g.faces.push_row(q);
-    }
-  return g;
+  return test::quad_grid(n, n, s, [=](double x, double) { return y0 + wave * std::sin(1.7 * x); }, x0, z0);
 }
-
-// b's elements appended to a's (vertex indices shifted).
-Garment merge(const Garment& a, const Garment& b) {
-  Garment g;
-  g.positions.resize(a.positions.rows() + b.positions.rows(), 3);
-  g.positions << a.positions, b.positions;
-  const Index base = Index(a.vertex_count());
-  const auto append = [&](const Csr& from_a, const Csr& from_b, Csr& out) {
-    out = from_a;
-    for (std::size_t e = 0; e < from_b.rows(); ++e) {
-      std::vector<Index> r(from_b.row(e).begin(), from_b.row(e).end());
-      for (Index& v : r) v += base;
-      out.push_row(r);
-    }
-  };
-  append(a.faces, b.faces, g.faces);
-  append(a.lines, b.lines, g.lines);
-  append(a.points, b.points, g.points);
-  return g;
-}
+Garment merge(const Garment& a, const Garment& b) { return test::merge_garments(a, b); }
 
 std::uint32_t max_layer(const std::vector<std::uint32_t>& l) { return *std::max_element(l.begin(), l.end()); }
 

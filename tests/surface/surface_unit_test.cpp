@@ -1,5 +1,7 @@
 // Surface shape optimisation (paper section 5) on small fixtures of our own:
 // a plane patch, a tube, a sphere, a point grid.
+#include "support/shapes.hpp"
+
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
 #include <refit/surface/agents.hpp>
@@ -14,42 +16,14 @@
 namespace refit {
 namespace {
 
-// A quad grid of nx x nz vertices, spacing s, on y = height(x, z), starting at (x0, z0).
 template <class H>
 Garment patch(int nx, int nz, double s, H&& height, double x0 = 0.0, double z0 = 0.0) {
-  Garment g;
-  g.positions.resize(nx * nz, 3);
-  for (int i = 0; i < nx; ++i)
-    for (int k = 0; k < nz; ++k) {
-      const double x = x0 + i * s, z = z0 + k * s;
-      g.positions.row(i * nz + k) << x, height(x, z), z;
-    }
-  for (int i = 0; i + 1 < nx; ++i)
-    for (int k = 0; k + 1 < nz; ++k) {
-      const Index a = Index(i * nz + k);
-      const std::array<Index, 4> q{a, a + 1, a + 1 + Index(nz), a + Index(nz)};
-      g.faces.push_row(q);
-    }
-  return g;
+  return test::quad_grid(nx, nz, s, height, x0, z0);
 }
 Garment flat_patch(int n, double s, double x0 = 0.0, double z0 = 0.0) {
   return patch(n, n, s, [](double, double) { return 0.0; }, x0, z0);
 }
-
-// Two garments in one (vertex indices of b shifted).
-Garment merge(const Garment& a, const Garment& b) {
-  Garment g;
-  g.positions.resize(a.positions.rows() + b.positions.rows(), 3);
-  g.positions << a.positions, b.positions;
-  g.faces = a.faces;
-  const Index base = Index(a.vertex_count());
-  for (std::size_t f = 0; f < b.faces.rows(); ++f) {
-    std::vector<Index> r(b.faces.row(f).begin(), b.faces.row(f).end());
-    for (Index& v : r) v += base;
-    g.faces.push_row(r);
-  }
-  return g;
-}
+Garment merge(const Garment& a, const Garment& b) { return test::merge_garments(a, b); }
 
 // Points on a sphere (Fibonacci spiral).
 Points sphere_points(int n, double radius) {
