@@ -164,7 +164,7 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
                "The paper's plain Gauss-Seidel sweeps instead of multigrid cycles (same solution when both converge)");
   app.add_flag("--encode-on-warped", a->encode_on_warped, "Encode the local shape on the warped garment, not the original");
   app.add_flag("--paper-surface", a->paper_surface,
-               "Surface step as the paper: fan-normal frames, eq. 4 blend of the warped vertices, no smoothing, "
+               "Surface step as the paper: fan-normal frames, eq. 4 blend of the warped vertices, no smoothing, no layers, "
                "--feature-zone 0");
   app.add_flag("--no-collision", a->no_collision, "Do not push vertices inside body B out");
   app.add_option("--clearance", a->clearance, "Collision clearance outside body B in cm")->capture_default_str();
