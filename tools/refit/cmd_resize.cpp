@@ -21,7 +21,7 @@ struct ResizeArgs {
   std::vector<std::string> to;
   std::size_t threads = 0, max_triangles = WarpOptions{}.max_triangles;
   bool quiet = false, metrics = false, paper_closeness = false, no_shape_control = false, no_collision = false, encode_on_warped = false,
-       paper_surface = false, plain_sweeps = false;
+       paper_surface = false, plain_sweeps = false, v_cycles = false;
   SurfaceOptions surface;
   double clearance = 0.2;
 };
@@ -48,6 +48,7 @@ int run(const ResizeArgs& a) {
   options.shape_matching.sampling_invariant = !a.paper_closeness;
   options.surface.encode_on_warped = a.encode_on_warped;
   if (a.plain_sweeps) options.surface.multigrid = false;
+  if (a.v_cycles) options.surface.krylov = false;
   if (a.paper_surface) {
     options.surface.fit_rotations = false;
     options.surface.smooth_blend = false;
@@ -160,8 +161,13 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
                "garment gets its own agents, rings and blends)");
   app.add_option("--max-iterations", a->surface.max_iterations, "Gauss-Seidel iterations, at most")->capture_default_str();
   app.add_option("--tolerance", a->surface.tolerance, "Gauss-Seidel stops below this update norm")->capture_default_str();
+  app.add_option("--tolerance-rms", a->surface.tolerance_rms,
+                 "If positive: stop when the update's RMS per free agent is below this (instead of --tolerance on its L2 norm)")
+      ->capture_default_str();
   app.add_flag("--plain-sweeps", a->plain_sweeps,
                "The paper's plain Gauss-Seidel sweeps instead of multigrid cycles (same solution when both converge)");
+  app.add_flag("--v-cycles", a->v_cycles,
+               "Bare multigrid V-cycles instead of BiCGSTAB preconditioned by them (same solution when both converge)");
   app.add_flag("--encode-on-warped", a->encode_on_warped, "Encode the local shape on the warped garment, not the original");
   app.add_flag("--paper-surface", a->paper_surface,
                "Surface step as the paper: fan-normal frames, eq. 4 blend of the warped vertices, no smoothing, no layers, "

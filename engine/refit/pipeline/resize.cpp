@@ -50,6 +50,8 @@ nlohmann::json surface_report(const SurfaceStats& s) {
           {"vertices_snapped", s.vertices_snapped},
           {"levels", s.levels},
           {"coarse_iterations", s.coarse_iterations},
+          {"krylov_iterations", s.krylov_iterations},
+          {"tolerance", s.tolerance},
           {"timings_ms",
            {{"sample", s.ms.sample},
             {"agents", s.ms.agents},

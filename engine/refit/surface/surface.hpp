@@ -57,6 +57,13 @@ struct SurfaceOptions {
   int coarsest_sweeps = 50;        // sweeps of the coarsest correction
   double multigrid_overcorrection = 1.5;  // aggregation's usual factor on each coarse correction (measured on the 40k
                                           // demo dress: 164 fine sweeps to the 1e-5 update with 1.0, 82 with 1.5)
+  bool krylov = true;              // with multigrid: BiCGSTAB preconditioned by one V-cycle instead of bare V-cycles, whose
+                                   // residual reduction per cycle degrades with the agent count (0.80 at 10k agents, 0.97
+                                   // at 95k: bench/README.md); false: bare V-cycles
+  int krylov_cycle_sweeps = 1;     // Gauss-Seidel sweeps before and after the coarse correction inside that V-cycle
+  double tolerance_rms = 0.0;      // > 0: stop when an iteration's update has an RMS over the free agents below this,
+                                   // instead of `tolerance` on its L2 norm (which asks sqrt(n) times more of each agent
+                                   // as the agent count n grows); 0 = the paper's L2 rule
   bool layers = true;              // beyond the paper: one agent per voxel and layer, rings and blends within a layer
                                    // (see garment_layers; false: the paper's one agent per voxel for the whole garment)
   double layer_min_area = 8.0;     // a piece is a layer from this face area on, in voxel areas (h^2)
@@ -99,6 +106,8 @@ struct SurfaceStats {
   std::size_t vertices_kept = 0;           // vertices within epsilon of body B, left at their warped positions
   int levels = 1;                          // solve levels (1 + coarse levels)
   int coarse_iterations = 0;               // Gauss-Seidel iterations spent on the coarse levels
+  int krylov_iterations = 0;               // BiCGSTAB iterations (each: 2 V-cycles, 2 products with the fine matrix)
+  double tolerance = 0.0;                  // the L2 update tolerance the fine solve used (from tolerance_rms when set)
   std::size_t feature_zone_agents = 0;     // agents in the features' zone (feature agents included; 0 without a zone)
   double feature_gap_before_snap = 0.0;    // largest distance from a feature sample carried on the output to its target
   double feature_gap = 0.0;                // the same after the snap (both 0 when the snap is off)
@@ -178,7 +187,7 @@ class SurfaceBinding {
 
   // V-cycles on the fine system with aggregation coarse levels (see surface.cpp).
   SolveReport solve_multigrid(const AgentRows& rows, const Points& h, const std::vector<std::uint8_t>& free, Points& x,
-                              const SolveOptions& solve) const;
+                              const SolveOptions& solve, int* krylov_iterations = nullptr) const;
 
   SurfaceOptions options_;
   double h_ = 0.0;
