@@ -52,6 +52,8 @@ struct SurfaceOptions {
   int clearance_rounds = 4;        // such re-solves, at most
   int coarse_levels = 4;           // coarse-to-fine start: agent subsets with voxels 2, 4, ... times larger (see apply)
   std::size_t coarse_min_agents = 50;    // no coarser level below this many agents
+  int coarse_start_sweeps = 50;    // with multigrid: Gauss-Seidel sweeps per level of the coarse-to-fine start, at most
+                                   // (without: max_iterations, as the paper's sweeps need the start)
   bool multigrid = true;           // V-cycles with Galerkin coarse operators after the coarse-to-fine start (false: plain sweeps)
   int multigrid_sweeps = 2;        // Gauss-Seidel sweeps before and after each coarse correction
   int coarsest_sweeps = 50;        // sweeps of the coarsest correction
@@ -121,6 +123,18 @@ struct SurfaceResult {
   SurfaceStats stats;
 };
 
+/// The fine system of apply's last solve, for benchmarks and tests: eq. 13's
+/// right-hand side, the free agents (after the clearance rounds), and the start
+/// (the coarse-to-fine one; fixed and clearance-held agents at their values).
+struct SurfaceSystem {
+  Points h;
+  std::vector<std::uint8_t> free;
+  Points start;
+};
+
+/// The fine solvers of eq. 13 (SurfaceOptions::multigrid and krylov choose apply's).
+enum class FineSolver { sweeps, v_cycles, krylov };
+
 /// Everything that depends only on the original garment and the feature samples.
 class SurfaceBinding {
  public:
@@ -147,12 +161,20 @@ class SurfaceBinding {
   /// from the agents' frames (eq. 4). `feature_warped` gives the feature samples'
   /// warped positions (their "before" frames); when null, each sample moves with its
   /// nearest garment vertex. Throws refit::Error on size mismatches or non-finite input.
+  /// `system`, when given, receives the fine system of the last solve.
   SurfaceResult apply(const Points& warped_vertices, const Points& feature_targets,
                       const std::function<double(const Vec3&)>& distance_to_body_b,
-                      const Points* feature_warped = nullptr) const;
+                      const Points* feature_warped = nullptr, SurfaceSystem* system = nullptr) const;
   /// The same with body B's Embree closest-point query.
   SurfaceResult apply(const Points& warped_vertices, const Points& feature_targets, const BodySurface& body_b,
-                      const Points* feature_warped = nullptr) const;
+                      const Points* feature_warped = nullptr, SurfaceSystem* system = nullptr) const;
+
+  /// Eq. 13 on the fine agents (rows() encoding) with right-hand side h, from x
+  /// (updated in place; agents with free[a] == 0 keep their x), by `solver` with
+  /// this binding's coarse levels and multigrid options. `krylov_iterations`,
+  /// when given, is increased by the BiCGSTAB iterations made.
+  SolveReport solve(const Points& h, const std::vector<std::uint8_t>& free, Points& x, const SolveOptions& options,
+                    FineSolver solver, int* krylov_iterations = nullptr) const;
 
   // Bound data, for tests, benchmarks and tools. Agents are in storage (block) order.
   const SurfaceOptions& options() const { return options_; }
@@ -187,7 +209,7 @@ class SurfaceBinding {
 
   // V-cycles on the fine system with aggregation coarse levels (see surface.cpp).
   SolveReport solve_multigrid(const AgentRows& rows, const Points& h, const std::vector<std::uint8_t>& free, Points& x,
-                              const SolveOptions& solve, int* krylov_iterations = nullptr) const;
+                              const SolveOptions& solve, bool krylov, int* krylov_iterations) const;
 
   SurfaceOptions options_;
   double h_ = 0.0;

@@ -7,7 +7,8 @@ namespace refit {
 
 // Own translation unit: callers of the std::function overload do not need Embree.
 SurfaceResult SurfaceBinding::apply(const Points& warped_vertices, const Points& feature_targets,
-                                    const BodySurface& body_b, const Points* feature_warped) const {
+                                    const BodySurface& body_b, const Points* feature_warped,
+                                    SurfaceSystem* system) const {
   // Only "closer than epsilon" matters, and (for apply's vertex test) a lower bound
   // a little beyond it: the bounded query stops early far from the body, and
   // "farther than the bound" is reported as the bound itself. Inside is negative.
@@ -19,7 +20,7 @@ SurfaceResult SurfaceBinding::apply(const Points& warped_vertices, const Points&
         const double d = std::min(body_b.closest_within(p, bound).distance, bound);
         return body_b.inside(p) ? -d : d;
       },
-      feature_warped);
+      feature_warped, system);
 }
 
 }  // namespace refit
