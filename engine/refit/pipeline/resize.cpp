@@ -51,6 +51,7 @@ nlohmann::json surface_report(const SurfaceStats& s) {
           {"levels", s.levels},
           {"coarse_iterations", s.coarse_iterations},
           {"krylov_iterations", s.krylov_iterations},
+          {"residual_reduction", s.reduction},
           {"tolerance", s.tolerance},
           {"timings_ms",
            {{"sample", s.ms.sample},

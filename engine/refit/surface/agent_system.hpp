@@ -79,6 +79,7 @@ struct SolveReport {
   int iterations = 0;
   double final_update = 0.0;
   bool converged = false;
+  double reduction = 0.0;  // multigrid: residual-norm factor of the last V-cycle, or the mean per BiCGSTAB iteration
 };
 
 /// Gauss-Seidel on eq. 13 from x (n x 3, updated in place); agents with free[a] == 0

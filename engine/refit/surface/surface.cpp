@@ -579,6 +579,8 @@ SolveReport SurfaceBinding::solve_multigrid(const AgentRows& rows, const Points&
         Points r = row_residual(rows, h, free, x), rhat = r, p = zero, v = zero;
         Col rho_old = Col::Ones(), alpha = Col::Ones(), omega = Col::Ones();
         const Points x_start = x;
+        const double r_start = r.norm();
+        int its = 0;
         while (rep.iterations < solve.max_iterations && jacobi_update(r) >= solve.tolerance) {
           const Col rho = dot(rhat, r);
           const Col beta = ratio(rho, rho_old) * ratio(alpha, omega);
@@ -597,6 +599,7 @@ SolveReport SurfaceBinding::solve_multigrid(const AgentRows& rows, const Points&
             r.col(c) = s.col(c) - omega[c] * t.col(c);
           }
           if (krylov_iterations) ++*krylov_iterations;
+          rep.reduction = std::pow(r.norm() / r_start, 1.0 / ++its);
           if (!x.allFinite() || !r.allFinite()) {
             x = x_start;
             krylov = false;
@@ -643,6 +646,7 @@ SolveReport SurfaceBinding::solve_multigrid(const AgentRows& rows, const Points&
       cycles = false;
       continue;
     }
+    if (std::isfinite(last_residual)) rep.reduction = norm / last_residual;
     last_residual = norm;
     x_before = x;
     x += options_.multigrid_overcorrection * correction(0, r);
@@ -829,6 +833,7 @@ SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
                                 : solve_multigrid(rows, h_fine, fr, x, o, options_.krylov, &st.krylov_iterations);
     st.iterations += rep.iterations;
     st.final_update = rep.final_update;
+    st.reduction = rep.reduction;
     st.converged = rep.converged || n == 0;
   };
   // Beyond the paper: eq. 14 holds only the agents the warp put within epsilon

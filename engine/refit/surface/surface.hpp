@@ -109,6 +109,7 @@ struct SurfaceStats {
   int levels = 1;                          // solve levels (1 + coarse levels)
   int coarse_iterations = 0;               // Gauss-Seidel iterations spent on the coarse levels
   int krylov_iterations = 0;               // BiCGSTAB iterations (each: 2 V-cycles, 2 products with the fine matrix)
+  double reduction = 0.0;                  // last fine solve: residual factor of its last V-cycle, or mean per BiCGSTAB iteration
   double tolerance = 0.0;                  // the L2 update tolerance the fine solve used (from tolerance_rms when set)
   std::size_t feature_zone_agents = 0;     // agents in the features' zone (feature agents included; 0 without a zone)
   double feature_gap_before_snap = 0.0;    // largest distance from a feature sample carried on the output to its target
