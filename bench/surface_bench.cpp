@@ -18,8 +18,9 @@
 // normal equations A^T A x = A^T b (eq. 13 is not symmetric), and BiCGSTAB on
 // A itself (Jacobi and IncompleteLUT preconditioners). The Eigen iterative
 // solvers stop at a relative residual of 1e-10 or when the time limit would be
-// passed (iteration cap from a short probe). A solver is skipped where the
-// measured growth from the previous size predicts more than the time limit.
+// passed (iteration cap from a short probe). A direct solver is skipped where
+// its time at the previous size, grown like n^1.5, predicts more than the time
+// limit; an iterative one (capped anyway) where it predicts 4 times that.
 //
 // Memory: peak resident set above the baseline while the solver runs (VmHWM
 // after resetting it through /proc/self/clear_refs, baseline VmRSS after
