@@ -301,6 +301,32 @@ TEST(SurfaceBindingTest, FeaturesPullTheSurfaceAndRebuildIsDeterministic) {
   EXPECT_LT(worst_result, 0.25 * worst_warp);
 }
 
+TEST(SurfaceBindingTest, KrylovSolveHandlesACoordinateThatIsAlreadySolved) {
+  // A flat patch stretched in its plane: the y coordinate is solved from the
+  // start (zero residual), x and z are not. BiCGSTAB must leave y exactly flat
+  // and converge on the rest without restarting over the solved coordinate.
+  const Garment g = flat_patch(60, 0.5);
+  Points warped = g.positions;
+  warped.col(0) *= 1.2;
+  SurfaceOptions o;
+  o.voxel = 0.5;
+  const SurfaceBinding b = SurfaceBinding::bind(g, Points(0, 3), o);
+  auto body = [](const Vec3& p) { return p.x() < 1.0 ? 0.0 : 1e9; };  // the x < 1 edge is held
+  SurfaceSystem sys;
+  const SurfaceResult r = b.apply(warped, Points(0, 3), body, nullptr, &sys);
+  ASSERT_GT(r.stats.levels, 1);
+  EXPECT_TRUE(r.stats.converged);
+  Points x = sys.start;
+  int krylov = 0;
+  const SolveReport rep = b.solve(sys.h, sys.free, x, {500, 1e-5, 1.0}, FineSolver::krylov, &krylov);
+  std::printf("  %zu agents: %d BiCGSTAB iterations, %d sweeps, update %.2e\n", b.agent_count(), krylov, rep.iterations,
+              rep.final_update);
+  EXPECT_TRUE(rep.converged);
+  EXPECT_GT(krylov, 0);
+  EXPECT_LT(krylov, 40);
+  EXPECT_EQ(x.col(1).cwiseAbs().maxCoeff(), 0.0);
+}
+
 TEST(SurfaceBindingTest, IsolatedPieceIsAnchoredAndDoesNotDrift) {
   // Piece 1 touches the body; piece 2 floats far from body and features.
   const Garment near = flat_patch(15, 0.5);

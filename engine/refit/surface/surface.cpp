@@ -605,8 +605,11 @@ SolveReport SurfaceBinding::solve_multigrid(const AgentRows& rows, const Points&
             krylov = false;
             break;
           }
-          // A breakdown (rho or omega zero) makes no further progress: restart.
-          if ((rho == 0.0).any() || (omega == 0.0).any()) break;
+          // A breakdown (rho or omega zero while that coordinate still has a
+          // residual) makes no further progress: restart. A coordinate already
+          // solved has zero scalars (ratio) and stays put.
+          const Col unsolved = dot(r, r);
+          if (((rho == 0.0 || omega == 0.0) && unsolved > 0.0).any()) break;
         }
       }
       // The paper's stopping rule, on real sweeps: the result is only called
