@@ -28,7 +28,8 @@ TEST(InspectCli, PrintsNameValueLines) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out,
             "vertices: 7\nfaces: 2\nlines: 1\npoints: 1\nunreferenced_vertices: 1\nedges: 5\n"
-            "boundary_edges: 4\nnon_manifold_edges: 0\nboundary_loops: 1\ncomponents: 2\n");
+            "boundary_edges: 4\nnon_manifold_edges: 0\nboundary_loops: 1\ncomponents: 2\nlayers: 1\n"
+            "loose_vertices: 2\n");
 }
 
 TEST(InspectCli, JsonHasTheSameNumbers) {
@@ -44,6 +45,8 @@ TEST(InspectCli, JsonHasTheSameNumbers) {
   EXPECT_EQ(j.at("edges"), 5);
   EXPECT_EQ(j.at("boundary_loops"), 1);
   EXPECT_EQ(j.at("components"), 2);
+  EXPECT_EQ(j.at("layers"), 1);          // the two triangles and the line hanging from them
+  EXPECT_EQ(j.at("loose_vertices"), 2);  // the point and the unreferenced vertex
   EXPECT_EQ(j.at("file"), path);
 }
 

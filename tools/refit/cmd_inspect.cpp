@@ -1,13 +1,16 @@
 // `refit inspect FILE.obj`: element counts and topology of a garment (counts,
 // unreferenced vertices, edges, boundary and non-manifold edges, boundary loops,
-// connected components), as `name: value` lines or, with --json, one JSON object.
+// connected components, and the layers the surface step finds at the default
+// agent budget), as `name: value` lines or, with --json, one JSON object.
 #include "command.hpp"
 
 #include <refit/core/topology.hpp>
 #include <refit/io/obj_garment.hpp>
+#include <refit/surface/surface.hpp>
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -29,6 +32,13 @@ const refit::cli::Register reg(
       return [opt]() -> int {
         const refit::Garment g = refit::read_garment_obj(opt->file);
         const refit::TopologyStats s = refit::topology_stats(g);
+        // Layers as `refit resize` sees them (default agent budget): pieces with
+        // their own agents; vertices on none (points, lines, small pieces) are loose.
+        const refit::SurfaceOptions so;
+        const std::vector<std::uint32_t> layer =
+            g.vertex_count() > 0 ? refit::surface_layers(g, so, refit::surface_voxel(g, so)) : std::vector<std::uint32_t>{};
+        const std::size_t layers = layer.empty() ? 0 : *std::max_element(layer.begin(), layer.end());
+        const std::size_t loose = static_cast<std::size_t>(std::count(layer.begin(), layer.end(), 0u));
         const std::vector<std::pair<const char*, std::size_t>> rows = {
             {"vertices", s.vertices},
             {"faces", s.faces},
@@ -40,6 +50,8 @@ const refit::cli::Register reg(
             {"non_manifold_edges", s.non_manifold_edges},
             {"boundary_loops", s.boundary_loops},
             {"components", s.components},
+            {"layers", layers},
+            {"loose_vertices", loose},
         };
         if (opt->json) {
           nlohmann::ordered_json j;

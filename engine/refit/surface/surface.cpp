@@ -136,6 +136,17 @@ void interpolation(const Points& fine, const std::vector<std::uint32_t>& fine_la
 
 }  // namespace
 
+double surface_voxel(const Garment& g, const SurfaceOptions& options) {
+  if (options.voxel != 0.0) return options.voxel;
+  // More agents than vertices adds no detail the reconstruction could show; it only slows the solve.
+  return auto_voxel_size(g, std::min(options.agent_budget, std::max<std::size_t>(g.vertex_count(), 1000)));
+}
+
+std::vector<std::uint32_t> surface_layers(const Garment& g, const SurfaceOptions& options, double voxel) {
+  if (!options.layers) return {};
+  return garment_layers(g, options.layer_min_area * voxel * voxel, options.layer_join * voxel);
+}
+
 SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, const SurfaceOptions& options,
                                     const SurfaceAttachment* feature_attachment) {
   check_options(options);
@@ -150,9 +161,7 @@ SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, co
   // the paper: agents, rings and encoding then serve every body B, and the
   // encoding is the original local shape the step restores (DESIGN.md).
   st.voxel_was_auto = options.voxel == 0.0;
-  // More agents than vertices adds no detail the reconstruction could show; it only slows the solve.
-  const std::size_t budget = std::min(options.agent_budget, std::max<std::size_t>(g.vertex_count(), 1000));
-  s.h_ = st.voxel_was_auto ? auto_voxel_size(g, budget) : options.voxel;
+  s.h_ = surface_voxel(g, options);
   st.voxel = s.h_;
   const VoxelGrid grid = make_voxel_grid(g, features, s.h_);
   const std::size_t nf = static_cast<std::size_t>(features.rows());
@@ -165,8 +174,7 @@ SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, co
                   " samples, the features " + std::to_string(nf));
     s.feature_attachment_ = feature_attachment ? *feature_attachment : attach_points(g, features);
   }
-  const std::vector<std::uint32_t> vertex_layer =
-      options.layers ? garment_layers(g, options.layer_min_area * s.h_ * s.h_, options.layer_join * s.h_) : std::vector<std::uint32_t>{};
+  const std::vector<std::uint32_t> vertex_layer = surface_layers(g, options, s.h_);
   std::vector<std::uint32_t> feature_layer(nf, 0);
   if (!vertex_layer.empty() && !s.feature_attachment_.vertex.empty())
     for (std::size_t k = 0; k < nf; ++k) {

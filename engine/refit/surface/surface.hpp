@@ -136,6 +136,14 @@ struct SurfaceSystem {
 /// The fine solvers of eq. 13 (SurfaceOptions::multigrid and krylov choose apply's).
 enum class FineSolver { sweeps, v_cycles, krylov };
 
+/// The voxel size h that SurfaceBinding::bind uses: options.voxel, or when it is
+/// 0 the automatic size for the agent budget (at most one agent per vertex).
+double surface_voxel(const Garment& g, const SurfaceOptions& options);
+
+/// The garment's layers as bind finds them with voxel size `voxel` (see
+/// garment_layers and SurfaceOptions::layers; empty when layers are off).
+std::vector<std::uint32_t> surface_layers(const Garment& g, const SurfaceOptions& options, double voxel);
+
 /// Everything that depends only on the original garment and the feature samples.
 class SurfaceBinding {
  public:
