@@ -63,9 +63,10 @@ VoxelGrid make_voxel_grid(const Garment& g, const Points& extra, double h);
 /// and pieces whose face boundaries come within `join_distance` of each other
 /// (panels cut apart with a small gap between them) joined; a piece whose face
 /// area is at least `min_area` is a layer, numbered 1, 2, ... in the order of
-/// its first vertex. Everything else (points, hanging lines, small pieces,
-/// unreferenced vertices) is layer 0, "loose": it belongs to no layer and
-/// moves with whatever surface is near it. Per vertex.
+/// its first vertex (a line or point sharing a vertex with a layer's faces is
+/// part of it). Everything else (small pieces, points and lines on their own,
+/// unreferenced vertices) is layer 0, "loose": it belongs to no layer and moves
+/// with whatever surface is near it. Per vertex.
 std::vector<std::uint32_t> garment_layers(const Garment& g, double min_area, double join_distance);
 
 /// A voxel of one layer.
