@@ -40,17 +40,25 @@ Constraint check_vertex(const Vec3& p, const BodySurface& body, double clearance
   return c;
 }
 
+// Corner mean of face f.
+Vec3 face_centre(const Garment& g, const Points& positions, std::size_t f) {
+  Vec3 centre = Vec3::Zero();
+  for (Index v : g.faces.row(f)) centre += row3(positions, v);
+  return centre / double(g.faces.row_size(f));
+}
+
+bool face_centre_inside(const Garment& g, const Points& positions, std::size_t f, const BodySurface& body) {
+  if (g.faces.row_size(f) < 3) return false;
+  const Vec3 centre = face_centre(g, positions, f);
+  return centre.allFinite() && body.inside(centre);
+}
+
 }  // namespace
 
 std::size_t count_face_centres_inside(const Garment& g, const Points& positions, const BodySurface& body) {
   body.prepare_inside_test();
   return deterministic_sum<std::size_t>(0, g.faces.rows(), kGrain, 0, [&](std::size_t f) {
-    const auto face = g.faces.row(f);
-    if (face.size() < 3) return std::size_t{0};
-    Vec3 centre = Vec3::Zero();
-    for (Index v : face) centre += row3(positions, v);
-    centre /= double(face.size());
-    return centre.allFinite() && body.inside(centre) ? std::size_t{1} : std::size_t{0};
+    return std::size_t{face_centre_inside(g, positions, f, body)};
   });
 }
 
@@ -161,14 +169,12 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
           const auto face = g.faces.row(f);
           if (face.size() < 3) continue;
           bool check = round == 0, ok = true;
-          Vec3 centre = Vec3::Zero();
           for (Index v : face) {
             check = check || check_face_of[v];
             ok = ok && finite[v];
-            centre += row3(positions, v);
           }
           if (!check || !ok) continue;
-          const Constraint c = check_vertex(centre / double(face.size()), body_b, options.clearance);
+          const Constraint c = check_vertex(face_centre(g, positions, f), body_b, options.clearance);
           if (!c.active) continue;
           faces_in[blk] += c.inside;
           if (round == 0) face_inside_before[f] = c.inside;
@@ -281,16 +287,8 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   // Only faces with a moved corner can have changed.
   report.face_centres_inside_after = deterministic_sum<std::size_t>(0, g.faces.rows(), kGrain, 0, [&](std::size_t f) {
     const auto face = g.faces.row(f);
-    if (face.size() < 3) return std::size_t{0};
-    bool moved = false;
-    Vec3 centre = Vec3::Zero();
-    for (Index v : face) {
-      moved = moved || is_touched[v];
-      centre += row3(positions, v);
-    }
-    if (!moved) return std::size_t{face_inside_before[f]};
-    centre /= double(face.size());
-    return centre.allFinite() && body_b.inside(centre) ? std::size_t{1} : std::size_t{0};
+    const bool moved = std::any_of(face.begin(), face.end(), [&](Index v) { return is_touched[v] != 0; });
+    return std::size_t{moved ? face_centre_inside(g, positions, f, body_b) : face_inside_before[f] != 0};
   });
   double total = 0.0;
   for (std::size_t k = 0; k < touched.size(); ++k) {
