@@ -84,8 +84,14 @@ int run(const DemoArgs& a) {
   for (const CurveResult& c : result.features.curves) curves.push_back(c.optimised);
   Garment warp_only = *garment;
   warp_only.positions = result.warped;
+  views.labels = {"warp alone (curves: where Refit puts the features)", "Refit"};
+  char title[160];
+  std::snprintf(title, sizeof title, "procedural dress on body_B (belly %+g cm, hip %g cm)", a.body_b.belly, a.body_b.hip);
+  views.title = title;
   write_png(path("before_after.png"), render(body_b, warp_only, &out, curves, views));
   views.width = 600;
+  views.labels = {};
+  views.title = "the design on body_A";
   write_png(path("design_on_A.png"), render(binding.body_a().mesh(), *garment, nullptr, {}, views));
 
   std::printf("refit demo: dress of %zu vertices resized from body_A to body_B (belly %+g cm, hip %g cm)\n",

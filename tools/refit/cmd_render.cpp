@@ -15,7 +15,7 @@ namespace refit::cli {
 namespace {
 
 struct RenderArgs {
-  std::string body, garment, garment2, curves, out, views = "front", size = "800x1000";
+  std::string body, garment, garment2, curves, out, views = "front", size = "800x1000", labels, title;
 };
 
 RenderOptions parse_options(const RenderArgs& a) {
@@ -30,6 +30,9 @@ RenderOptions parse_options(const RenderArgs& a) {
   o.views.clear();
   std::stringstream vs(a.views);
   for (std::string v; std::getline(vs, v, ',');) o.views.push_back(parse_view(v));
+  std::stringstream ls(a.labels);
+  for (std::string l; std::getline(ls, l, ',');) o.labels.push_back(l);
+  o.title = a.title;
   return o;
 }
 
@@ -70,6 +73,8 @@ const Register reg("render", "ray-traced PNG of a body with one or two garments 
                      app.add_option("--out", args->out, "PNG to write")->required();
                      app.add_option("--views", args->views, "comma-separated views: front, side, back (default front)");
                      app.add_option("--size", args->size, "picture size WIDTHxHEIGHT (default 800x1000)");
+                     app.add_option("--labels", args->labels, "comma-separated labels over the garments, e.g. 'warp alone,Refit'");
+                     app.add_option("--title", args->title, "title across the top, e.g. the body's name");
                      return [args] { return run(*args); };
                    });
 

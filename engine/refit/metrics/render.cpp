@@ -10,9 +10,11 @@
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmissing-field-initializers"
 #pragma GCC diagnostic ignored "-Wunused-parameter"
+#pragma GCC diagnostic ignored "-Wunused-function"
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #define STBI_WRITE_NO_STDIO
 #include <stb_image_write.h>
+#include <stb_easy_font.h>
 #pragma GCC diagnostic pop
 
 #include <algorithm>
@@ -117,6 +119,31 @@ void grow(Vec3& lo, Vec3& hi, const Points& p) {
     }
 }
 
+// Text in black with stb_easy_font (a 6-pixel-high stroke font made of quads),
+// each font pixel drawn as a scale x scale block; clipped to the image.
+void draw_text(Image& img, int x, int y, const std::string& text, int scale) {
+  if (text.empty()) return;
+  std::vector<char> buffer(text.size() * 270 + 1000);  // stb_easy_font: up to ~270 bytes per character
+  std::string copy = text;
+  unsigned char black[4] = {0, 0, 0, 255};
+  const int quads = stb_easy_font_print(0, 0, copy.data(), black, buffer.data(), static_cast<int>(buffer.size()));
+  for (int q = 0; q < quads; ++q) {
+    const float* v = reinterpret_cast<const float*>(buffer.data() + static_cast<std::size_t>(q) * 64);
+    // Vertices 0 and 2 of a quad are opposite corners (each vertex: x, y, z, colour = 16 bytes).
+    const int x0 = x + static_cast<int>(std::lround(v[0] * scale)), y0 = y + static_cast<int>(std::lround(v[1] * scale));
+    const int x1 = x + static_cast<int>(std::lround(v[8] * scale)), y1 = y + static_cast<int>(std::lround(v[9] * scale));
+    for (int py = std::max(0, y0); py < std::min(img.height, y1); ++py)
+      for (int px = std::max(0, x0); px < std::min(img.width, x1); ++px)
+        std::fill_n(&img.rgb[(static_cast<std::size_t>(py) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(px)) * 3], 3,
+                    std::uint8_t{0});
+  }
+}
+
+int text_width(const std::string& text, int scale) {
+  std::string copy = text;
+  return stb_easy_font_width(copy.data()) * scale;
+}
+
 }  // namespace
 
 View parse_view(const std::string& name, const std::string& what) {
@@ -164,7 +191,12 @@ Image render(const BodyMesh& body, const Garment& garment, const Garment* garmen
   const double total = std::accumulate(across.begin(), across.end(), 0.0);
   double upward = 0.0;
   for (const Panel& p : panels) upward = std::max(upward, std::abs(ext.dot(p.camera.up)));
-  const double scale = 1.08 * std::max(total / options.width, upward / options.height) + 1e-12;
+  // A band at the top for the title and the labels; the bodies are framed below it.
+  const int text_scale = std::max(1, options.height / 300);
+  const int band = (options.title.empty() ? 0 : 10 * text_scale) + (options.labels.empty() ? 0 : 10 * text_scale) +
+                   (options.title.empty() && options.labels.empty() ? 0 : 2 * text_scale);
+  const double scale = 1.08 * std::max(total / options.width, upward / std::max(1, options.height - band)) + 1e-12;
+  const double middle_y = 0.5 * (options.height + band);  // picture row of the box's centre
   double edge = 0.0;
   for (std::size_t i = 0; i < panels.size(); ++i) {
     panels[i].x0 = static_cast<int>(std::lround(edge / total * options.width));
@@ -189,7 +221,7 @@ Image render(const BodyMesh& body, const Garment& garment, const Garment* garmen
         const Camera& c = p.camera;
         for (int x = p.x0; x < p.x0 + p.width; ++x) {
           const double u = (x - p.x0 + 0.5 - 0.5 * p.width) * pixel[pi];
-          const double v = (0.5 * img.height - (static_cast<double>(y) + 0.5)) * pixel[pi];
+          const double v = (middle_y - (static_cast<double>(y) + 0.5)) * pixel[pi];
           const Vec3 o = centre + u * c.right + v * c.up - depth * c.forward;
           RTCRayHit rh = make_ray(o, c.forward);
           rtcIntersect1(scenes[static_cast<std::size_t>(p.garment)]->get(), &ctx, &rh);
@@ -214,7 +246,7 @@ Image render(const BodyMesh& body, const Garment& garment, const Garment* garmen
     auto to_pixel = [&](const Vec3& q) {
       const Vec3 d = q - centre;
       return Eigen::Vector2d(p.x0 + 0.5 * p.width + d.dot(p.camera.right) / pixel[pi],
-                             0.5 * img.height - d.dot(p.camera.up) / pixel[pi]);
+                             middle_y - d.dot(p.camera.up) / pixel[pi]);
     };
     auto stamp = [&](const Eigen::Vector2d& s) {
       for (int y = static_cast<int>(std::floor(s.y() - radius)); y <= static_cast<int>(std::ceil(s.y() + radius)); ++y)
@@ -235,6 +267,17 @@ Image render(const BodyMesh& body, const Garment& garment, const Garment* garmen
         for (int s = 0; s <= steps; ++s) stamp(a + (b - a) * (static_cast<double>(s) / steps));
       }
   }
+
+  // Labels: centred over each garment's panels; the title across the top.
+  const int line = 10 * text_scale;
+  for (std::size_t g = 0; g < scenes.size() && g < options.labels.size(); ++g) {
+    int x0 = img.width, x1 = 0;
+    for (const Panel& p : panels)
+      if (p.garment == static_cast<int>(g)) x0 = std::min(x0, p.x0), x1 = std::max(x1, p.x0 + p.width);
+    const int top = options.title.empty() ? text_scale * 2 : text_scale * 2 + line;
+    draw_text(img, (x0 + x1 - text_width(options.labels[g], text_scale)) / 2, top, options.labels[g], text_scale);
+  }
+  draw_text(img, (img.width - text_width(options.title, text_scale)) / 2, text_scale * 2, options.title, text_scale);
   return img;
 }
 

@@ -20,6 +20,8 @@ View parse_view(const std::string& name, const std::string& what = "--views");
 struct RenderOptions {
   int width = 800, height = 1000;       // whole picture, pixels
   std::vector<View> views = {View::front};
+  std::vector<std::string> labels;  // written above garment 1's panels, then garment 2's (may be empty)
+  std::string title;                // written across the top (may be empty)
 };
 
 struct Image {
@@ -30,6 +32,7 @@ struct Image {
 /// One panel per (garment, view): garment 1's panels on the left half, garment 2's
 /// (when given) on the right. Each panel shows the body and that garment; every
 /// polyline in `curves` is drawn on top of garment 1's panels as a thick line.
+/// `options.labels` and `options.title` are written in black on the background.
 /// Throws refit::Error for a size below 16x16 or above 16384 per side, or no view.
 Image render(const BodyMesh& body, const Garment& garment, const Garment* garment2,
              const std::vector<Points>& curves, const RenderOptions& options);
