@@ -323,7 +323,29 @@ def main():
             for k, ok in v[m].items():
                 if not ok:
                     failures.setdefault(m, {}).setdefault(k, []).append("%s/%s" % (case.garment, case.target))
-            dump.append({"garment": case.garment, "body": case.target, "method": m, "scores": s, "targets": v[m]})
+            dump.append({"garment": case.garment, "body": case.target, "method": m, "scores": s,
+                         "targets": {k: bool(ok) for k, ok in v[m].items()}})
+    print()
+    print("Summary over the cases (worst / median):")
+    print()
+    print("| method | flipped | inside v / faces | near-body change cm | mirror - warp's cm | height ratio / warp's | "
+          "features vs warp (least) | between vs warp (least) | feature gap cm |")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for m in args.methods:
+        got = [(rows[m], rows.get("warp")) for _, rows in results if m in rows]
+        if not got:
+            continue
+        col = lambda f: [f(s, w) for s, w in got if f(s, w) is not None]
+        wm = lambda xs, worst=max: "%.2f / %.2f" % (worst(xs), float(np.median(xs))) if xs else ""
+        least = lambda key: lambda s, w: (min(w[key][k] / max(e, 1e-12) for k, e in s[key].items())
+                                          if s.get(key) and w and m != "warp" else None)
+        print("| %s | %d | %d / %d | %s | %s | %s | %s | %s | %s |" % (
+            m, max(s["flipped"] for s, _ in got), max(s["inside_vertices"] for s, _ in got),
+            max(s["inside_faces"] for s, _ in got), wm(col(lambda s, w: s["near_body_change"])),
+            wm(col(lambda s, w: s["mirror"] - w["mirror"] if w else None)),
+            wm(col(lambda s, w: abs(s["height_ratio"] / w["height_ratio"] - 1) + 1 if w else None)),
+            wm(col(least("feature_errors")), min), wm(col(least("held_errors")), min),
+            wm(col(lambda s, w: s.get("feature_gap")))))
     print()
     print("Targets of issue 13 missed (cases):")
     methods = [m for m in args.methods if any(m in rows for _, rows in results)]
