@@ -1,6 +1,6 @@
 // Penetration test and resolution, and rendering, on a 1M-vertex garment
 // (targets: under 0.5 s and under 1 s with 2 threads).
-#include <refit/metrics/collision.hpp>
+#include <refit/collision/collision.hpp>
 #include <refit/metrics/metrics.hpp>
 #include <refit/metrics/render.hpp>
 

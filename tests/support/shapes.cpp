@@ -5,6 +5,14 @@
 
 namespace refit::test {
 
+Garment icosphere_garment(int levels, double radius) {
+  const BodyMesh m = icosphere(levels, radius);
+  Garment g;
+  g.positions = m.vertices;
+  for (const auto& t : m.triangles) g.faces.push_row(t);
+  return g;
+}
+
 BodyMesh icosphere(int levels, double radius, const Vec3& centre) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
   std::vector<Vec3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},

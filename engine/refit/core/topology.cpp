@@ -240,4 +240,54 @@ std::vector<std::vector<Index>> loops_from_edges(const Garment& g, const FaceEdg
 
 }  // namespace
 
+Csr vertex_adjacency(const Garment& g) {
+  const std::size_t n = g.vertex_count();
+  std::vector<Index> count(n + 1, 0);
+  auto each_edge = [&](auto&& f) {
+    for (std::size_t r = 0; r < g.faces.rows(); ++r) {
+      const auto face = g.faces.row(r);
+      for (std::size_t k = 0; k < face.size(); ++k) f(face[k], face[(k + 1) % face.size()]);
+    }
+    for (std::size_t r = 0; r < g.lines.rows(); ++r) {
+      const auto line = g.lines.row(r);
+      for (std::size_t k = 0; k + 1 < line.size(); ++k) f(line[k], line[k + 1]);
+    }
+  };
+  each_edge([&](Index a, Index b) {
+    if (a == b) return;
+    ++count[a + 1];
+    ++count[b + 1];
+  });
+  Csr adj;
+  adj.offsets.assign(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) adj.offsets[i + 1] = adj.offsets[i] + count[i + 1];
+  adj.indices.resize(adj.offsets[n]);
+  std::vector<Index> fill(adj.offsets.begin(), adj.offsets.end() - 1);
+  each_edge([&](Index a, Index b) {
+    if (a == b) return;
+    adj.indices[fill[a]++] = b;
+    adj.indices[fill[b]++] = a;
+  });
+  // Sort and drop duplicates (shared edges appear once per face) row by row.
+  std::vector<Index> row_size(n, 0);
+  parallel_for(0, n, 4096, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      auto* first = adj.indices.data() + adj.offsets[i];
+      auto* last = adj.indices.data() + adj.offsets[i + 1];
+      std::sort(first, last);
+      row_size[i] = static_cast<Index>(std::unique(first, last) - first);
+    }
+  });
+  Index out = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Index begin = adj.offsets[i];
+    std::copy(adj.indices.begin() + begin, adj.indices.begin() + begin + row_size[i], adj.indices.begin() + out);
+    adj.offsets[i] = out;
+    out += row_size[i];
+  }
+  adj.offsets[n] = out;
+  adj.indices.resize(out);
+  return adj;
+}
+
 }  // namespace refit

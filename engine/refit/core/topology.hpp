@@ -23,4 +23,7 @@ TopologyStats topology_stats(const Garment& g);
 /// closed vertex cycle (first vertex not repeated). Deterministic order.
 std::vector<std::vector<Index>> boundary_loops(const Garment& g);
 
+/// Vertex adjacency (CSR, sorted, no duplicates) from faces and `l` lines.
+Csr vertex_adjacency(const Garment& g);
+
 }  // namespace refit

@@ -1,4 +1,3 @@
-#include <refit/metrics/collision.hpp>
 #include <refit/metrics/metrics.hpp>
 
 #include <refit/body/centre_tree.hpp>
@@ -21,6 +20,14 @@ namespace {
 
 constexpr std::size_t kGrain = 2048;
 
+// Corner mean of face f.
+Vec3 face_centre(const Garment& g, const Points& positions, std::size_t f) {
+  Vec3 centre = Vec3::Zero();
+  for (Index v : g.faces.row(f)) centre += row3(positions, v);
+  return centre / double(g.faces.row_size(f));
+}
+
+
 bool finite_row(const Points& p, Eigen::Index i) { return p.row(i).allFinite(); }
 
 // The value at quantile q of `v` (nearest rank); v is reordered.
@@ -36,6 +43,16 @@ nlohmann::json scores_json(const CurveScores& s) {
 }
 
 }  // namespace
+
+std::size_t count_face_centres_inside(const Garment& g, const Points& positions, const BodySurface& body) {
+  body.prepare_inside_test();
+  return deterministic_sum<std::size_t>(0, g.faces.rows(), kGrain, 0, [&](std::size_t f) {
+    if (g.faces.row_size(f) < 3) return std::size_t{0};
+    const Vec3 centre = face_centre(g, positions, f);
+    return std::size_t{centre.allFinite() && body.inside(centre)};
+  });
+}
+
 
 Vec3 face_normal(const Points& positions, std::span<const Index> face) {
   Vec3 n = Vec3::Zero();

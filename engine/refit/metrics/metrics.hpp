@@ -122,4 +122,7 @@ std::vector<FeatureCurveInput> feature_curve_inputs(const Garment& original, con
 /// Newell normal of face f (not normalised; zero for a degenerate face).
 Vec3 face_normal(const Points& positions, std::span<const Index> face);
 
+/// Faces (3 corners or more) whose centre (corner mean) is inside `body`. Parallel.
+std::size_t count_face_centres_inside(const Garment& g, const Points& positions, const BodySurface& body);
+
 }  // namespace refit

@@ -2,7 +2,7 @@
 #include <refit/core/error.hpp>
 #include <refit/features/curve_metrics.hpp>
 #include <refit/features/feature_curves.hpp>
-#include <refit/metrics/collision.hpp>
+#include <refit/collision/collision.hpp>
 #include <refit/metrics/metrics.hpp>
 #include <refit/pipeline/resize.hpp>
 #include <refit/pipeline/units.hpp>

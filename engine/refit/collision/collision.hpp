@@ -40,10 +40,4 @@ struct CollisionReport {
 CollisionReport resolve_penetrations(const Garment& g, Points& positions, const BodySurface& body_b,
                                      const CollisionOptions& options = {});
 
-/// Faces (3 corners or more) whose centre (corner mean) is inside `body`. Parallel.
-std::size_t count_face_centres_inside(const Garment& g, const Points& positions, const BodySurface& body);
-
-/// Vertex adjacency (CSR, sorted, no duplicates) from faces and `l` lines.
-Csr vertex_adjacency(const Garment& g);
-
 }  // namespace refit

@@ -1,0 +1,189 @@
+// The collision step: garment vertices and faces inside body B or too close come
+// out, smoothly, locally and for any thread count the same.
+#include <refit/collision/collision.hpp>
+#include <refit/core/error.hpp>
+#include <refit/core/parallel.hpp>
+#include <refit/core/topology.hpp>
+#include <refit/metrics/metrics.hpp>
+
+#include <mannequin/mannequin.hpp>
+
+#include "support/shapes.hpp"
+#include "support/test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace refit {
+namespace {
+
+BodyMesh sphere_body(int levels, double radius) { return test::icosphere(levels, radius); }
+
+Garment sphere_garment(int levels, double radius) { return test::icosphere_garment(levels, radius); }
+
+// -- penetration resolution -----------------------------------------------------
+
+struct Pushed {
+  BodyMesh body;
+  Garment garment;
+  Points pushed;
+};
+
+// The mannequin's top, with the front of the torso band between two heights
+// pushed 2 cm into the body.
+Pushed pushed_top() {
+  mannequin::BodyParams bp;
+  Pushed p;
+  p.body = mannequin::make_body(bp);
+  mannequin::GarmentParams gp;
+  gp.kind = mannequin::GarmentParams::Kind::Top;
+  gp.target_vertices = 6000;
+  p.garment = mannequin::make_garment(bp, gp);
+  const auto lm = mannequin::landmarks(bp);
+  p.pushed = p.garment.positions;
+  for (Eigen::Index i = 0; i < p.pushed.rows(); ++i) {
+    const double y = p.pushed(i, 1), z = p.pushed(i, 2);
+    if (y > lm.waist && y < lm.bust && z > 0.0) {
+      const double w = std::sin(M_PI * (y - lm.waist) / (lm.bust - lm.waist));
+      const double front = std::clamp(z / 10.0, 0.0, 1.0);
+      p.pushed(i, 2) -= 2.5 * w * front * front * (3.0 - 2.0 * front);
+    }
+  }
+  return p;
+}
+
+TEST(Collision, PushedTopComesOutSmoothlyAndOnlyLocally) {
+  Pushed p = pushed_top();
+  const BodySurface body(p.body);
+  const PenetrationMetrics before = measure_penetration(p.pushed, body);
+  ASSERT_GT(before.inside, 50u) << "the fixture must start inside the body";
+
+  CollisionOptions o;
+  Points out = p.pushed;
+  const CollisionReport r = resolve_penetrations(p.garment, out, body, o);
+  EXPECT_EQ(r.inside_before, before.inside);
+  EXPECT_EQ(r.inside_after, 0u);
+  EXPECT_EQ(measure_penetration(out, body).inside, 0u);
+  EXPECT_GE(r.moved, r.too_close);
+  EXPECT_GT(r.max_displacement, 1.0);
+
+  // No face flipped that was not flipped already (relative to the pushed input
+  // and to the garment as designed).
+  Garment pushed_garment = p.garment;
+  pushed_garment.positions = p.pushed;
+  EXPECT_EQ(measure_sanity(pushed_garment, out).flipped_faces, 0u);
+  EXPECT_LE(measure_sanity(p.garment, out).flipped_faces, measure_sanity(p.garment, p.pushed).flipped_faces);
+
+  // Untouched: vertices more than smoothing_rings edges from any too-close
+  // vertex (inside or within the clearance, or a corner of a face whose centre
+  // is) keep their exact position; everything that moved is within those rings.
+  const Csr adj = vertex_adjacency(p.garment);
+  const std::size_t n = p.garment.vertex_count();
+  std::vector<int> ring(n, -1);
+  std::vector<Index> frontier;
+  const auto too_close = [&](const Vec3& q) { return body.inside(q) || body.closest(q).distance < o.clearance; };
+  for (Index i = 0; i < n; ++i)
+    if (too_close(row3(p.pushed, i))) ring[i] = 0;
+  for (std::size_t f = 0; f < p.garment.faces.rows(); ++f) {
+    Vec3 centre = Vec3::Zero();
+    for (Index v : p.garment.faces.row(f)) centre += row3(p.pushed, v);
+    if (too_close(centre / double(p.garment.faces.row_size(f))))
+      for (Index v : p.garment.faces.row(f)) ring[v] = 0;
+  }
+  for (Index i = 0; i < n; ++i)
+    if (ring[i] == 0) frontier.push_back(i);
+  for (int level = 1; level <= o.smoothing_rings; ++level) {
+    std::vector<Index> next;
+    for (Index i : frontier)
+      for (Index j : adj.row(i))
+        if (ring[j] < 0) {
+          ring[j] = level;
+          next.push_back(j);
+        }
+    frontier = std::move(next);
+  }
+  std::size_t far_untouched = 0, moved = 0;
+  double max_step_ratio = 0.0;
+  for (Index i = 0; i < n; ++i) {
+    const bool changed = (out.row(i) - p.pushed.row(i)).squaredNorm() > 0.0;
+    moved += changed;
+    if (ring[i] < 0) {
+      EXPECT_FALSE(changed) << "vertex " << i << " is far from every too-close vertex but moved";
+      ++far_untouched;
+    }
+  }
+  EXPECT_GT(far_untouched, n / 2);
+  EXPECT_EQ(moved, r.moved);
+  // Smooth: along every edge, the displacement difference stays well below the
+  // largest displacement (a spike would make one edge carry all of it).
+  for (Index i = 0; i < n; ++i)
+    for (Index j : adj.row(i)) {
+      const double di = (out.row(i) - p.pushed.row(i)).norm(), dj = (out.row(j) - p.pushed.row(j)).norm();
+      max_step_ratio = std::max(max_step_ratio, std::abs(di - dj) / r.max_displacement);
+    }
+  EXPECT_LT(max_step_ratio, 0.6);
+
+  // Nothing to do on the garment as designed (already outside the clearance).
+  Points designed = p.garment.positions;
+  const CollisionReport none = resolve_penetrations(p.garment, designed, body, o);
+  EXPECT_EQ(none.too_close, 0u);
+  EXPECT_EQ(none.moved, 0u);
+  EXPECT_TRUE(designed == p.garment.positions);
+}
+
+TEST(Collision, TheBodyPokingThroughACoarseFaceIsPushedOutToo) {
+  // A flat 5 x 5 grid of 4 cm quads at y = 9.8 over a sphere of radius 10: the
+  // corners nearest its top, (+-2, +-2), clear the body by about 0.2 (more than
+  // the clearance, 0.1), but the sphere's top pokes through the middle face.
+  const BodySurface body(sphere_body(4, 10.0));
+  Garment g;
+  g.positions.resize(36, 3);
+  for (int i = 0; i < 6; ++i)
+    for (int k = 0; k < 6; ++k) g.positions.row(i * 6 + k) << -10.0 + 4.0 * i, 9.8, -10.0 + 4.0 * k;
+  for (int i = 0; i < 5; ++i)
+    for (int k = 0; k < 5; ++k) {
+      const Index a = Index(i * 6 + k);
+      g.faces.push_row(std::array<Index, 4>{a, a + 1, a + 7, a + 6});
+    }
+  CollisionOptions o;
+  o.clearance = 0.1;
+  Points out = g.positions;
+  ASSERT_EQ(measure_penetration(out, body).inside, 0u);
+  for (Index v = 0; v < 36; ++v) ASSERT_GT(body.closest(row3(out, v)).distance, o.clearance) << v;
+  ASSERT_EQ(count_face_centres_inside(g, out, body), 1u);
+  const CollisionReport r = resolve_penetrations(g, out, body, o);
+  EXPECT_EQ(r.too_close, 0u);  // no vertex of its own
+  EXPECT_EQ(r.face_centres_inside_before, 1u);
+  EXPECT_EQ(r.face_centres_inside_after, 0u);
+  EXPECT_EQ(count_face_centres_inside(g, out, body), 0u);
+  // The middle face's centre clears the body by the clearance now.
+  Vec3 centre = Vec3::Zero();
+  for (Index v : g.faces.row(12)) centre += row3(out, v);
+  EXPECT_GE(body.closest(centre / 4.0).distance, o.clearance * 0.99);
+  EXPECT_GT(r.moved, 4u);
+}
+
+TEST(Collision, SphereShellPartlyInsideComesOutBitIdenticalForAnyThreadCount) {
+  const BodySurface body(sphere_body(3, 10.0));
+  const Garment g = sphere_garment(3, 10.4);
+  Points shifted = g.positions.rowwise() + Eigen::RowVector3d(1.5, 0, 0);
+  Points one = shifted, two = shifted;
+  CollisionReport r1, r2;
+  {
+    ThreadLimit limit(1);
+    r1 = resolve_penetrations(g, one, body);
+  }
+  r2 = resolve_penetrations(g, two, body);
+  EXPECT_GT(r1.inside_before, 10u);
+  EXPECT_EQ(r1.inside_after, 0u);
+  EXPECT_TRUE(one == two);
+  EXPECT_EQ(r1.moved, r2.moved);
+  EXPECT_EQ(measure_penetration(one, body).inside, 0u);
+  EXPECT_EQ(measure_sanity(g, one).flipped_faces, 0u);
+  for (Eigen::Index i = 0; i < one.rows(); ++i) EXPECT_GT(body.closest(row3(one, static_cast<Index>(i))).distance, 0.2 - 1e-9);
+  EXPECT_THROW(resolve_penetrations(g, shifted, body, CollisionOptions{-1.0}), Error);
+}
+
+}  // namespace
+}  // namespace refit
