@@ -91,7 +91,17 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
   if (!features.empty()) {
     clock.reset();
     progress.stage("sampling " + std::to_string(features.size()) + " feature curves");
-    features_ = bind_features(body_a_, build_feature_curves(*garment_, features), options_.shape_matching);
+    std::vector<FeatureCurve> curves = build_feature_curves(*garment_, features);
+    const SymmetryCheck sym = check_symmetry(garment_->positions, body_a_.mesh().vertices,
+                                             options_.symmetry_tolerance_cm * per_cm, options_.symmetry);
+    const std::size_t given = curves.size();
+    if (sym.symmetric) curves = add_mirrored_curves(std::move(curves), sym.plane_x);
+    nlohmann::json mirrored = nlohmann::json::array();
+    for (std::size_t i = given; i < curves.size(); ++i) mirrored.push_back(curves[i].name);
+    symmetry_report_ = {{"plane_x", sym.plane_x},          {"garment_error", sym.garment_error},
+                        {"body_a_error", sym.body_error},  {"tolerance", sym.tolerance},
+                        {"symmetric", sym.symmetric},      {"mirrored_features", mirrored}};
+    features_ = bind_features(body_a_, std::move(curves), options_.shape_matching);
     bind_report_["features"] = clock.ms();
   }
   if (options_.stage == Stage::Full) {
@@ -148,6 +158,7 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
     progress.stage("optimising " + std::to_string(features_->model.curves.size()) + " feature curves");
     curves = optimise_features(*features_, frames_b, distance_b);
     timings["features"] = clock.ms();
+    report["symmetry"] = symmetry_report_;
     nlohmann::json& list = report["features"];
     list = nlohmann::json::array();
     for (const CurveResult& c : curves.curves) {

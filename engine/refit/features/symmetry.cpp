@@ -1,0 +1,90 @@
+#include <refit/features/symmetry.hpp>
+
+#include <refit/body/centre_tree.hpp>
+#include <refit/core/error.hpp>
+#include <refit/core/parallel.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace refit {
+namespace {
+
+Vec3 mirror_point(const Vec3& p, double c) { return {2.0 * c - p.x(), p.y(), p.z()}; }
+Vec3 mirror_dir(const Vec3& d) { return {-d.x(), d.y(), d.z()}; }
+
+// 95th percentile of the distance from each mirrored point to the nearest point of the set:
+// robust to a few one-sided details (a button, a label).
+double mirror_error(const Points& p, double c) {
+  if (p.rows() == 0) return 0.0;
+  const PointTree tree(p);
+  const std::size_t n = static_cast<std::size_t>(p.rows());
+  std::vector<double> d(n);
+  parallel_for(0, n, 1024, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) d[i] = std::sqrt(tree.nearest(mirror_point(row3(p, static_cast<Index>(i)), c)).second);
+  });
+  const std::size_t k = std::min(n - 1, static_cast<std::size_t>(0.95 * static_cast<double>(n)));
+  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(k), d.end());
+  return d[k];
+}
+
+}  // namespace
+
+SymmetryMode parse_symmetry(const std::string& s) {
+  if (s == "auto") return SymmetryMode::Auto;
+  if (s == "x") return SymmetryMode::X;
+  if (s == "none") return SymmetryMode::None;
+  throw Error("--symmetry: unknown mode '" + s + "' (use auto, x or none)");
+}
+
+Points mirror_x(const Points& p, double c) {
+  Points m = p;
+  m.col(0) = (2.0 * c) - p.col(0).array();
+  return m;
+}
+
+SymmetryCheck check_symmetry(const Points& garment, const Points& body_a, double tolerance, SymmetryMode mode) {
+  SymmetryCheck s;
+  s.tolerance = tolerance;
+  if (body_a.rows() > 0) s.plane_x = 0.5 * (body_a.col(0).minCoeff() + body_a.col(0).maxCoeff());
+  if (mode == SymmetryMode::None) return s;
+  s.garment_error = mirror_error(garment, s.plane_x);
+  s.body_error = mirror_error(body_a, s.plane_x);
+  s.symmetric = mode == SymmetryMode::X || (s.garment_error <= tolerance && s.body_error <= tolerance);
+  return s;
+}
+
+std::vector<FeatureCurve> add_mirrored_curves(std::vector<FeatureCurve> curves, double c, double coincide) {
+  const std::size_t given = curves.size();
+  std::vector<PointTree> trees;
+  trees.reserve(given);
+  for (const FeatureCurve& k : curves) trees.emplace_back(k.samples);
+  for (std::size_t i = 0; i < given; ++i) {
+    const FeatureCurve& src = curves[i];
+    const Points m = mirror_x(src.samples, c);
+    bool covered = false;
+    for (std::size_t k = 0; k < given && !covered; ++k) {
+      const double tol = coincide * std::max(src.spacing(), curves[k].spacing());
+      double worst = 0.0;
+      for (Index r = 0; r < m.rows(); ++r) worst = std::max(worst, std::sqrt(trees[k].nearest(row3(m, r)).second));
+      covered = worst <= tol;
+    }
+    if (covered) continue;
+    FeaturePlane plane;
+    plane.point = mirror_point(src.plane.point, c);
+    plane.axis_u = mirror_dir(src.plane.axis_u);
+    plane.axis_v = mirror_dir(src.plane.axis_v);
+    plane.normal = plane.axis_u.cross(plane.axis_v);  // keeps the frame right-handed
+    // Auxiliary points: the source's, mirrored (the same estimate of the new plane on both sides).
+    FeatureCurve mc;
+    mc.name = src.name + "~mirror";
+    mc.closed = src.closed;
+    mc.samples = m;
+    mc.plane = plane;
+    mc.aux = mirror_x(src.aux, c);
+    curves.push_back(std::move(mc));
+  }
+  return curves;
+}
+
+}  // namespace refit

@@ -1,0 +1,39 @@
+#pragma once
+// Left/right symmetry of a garment and body A about a plane x = c (issue 13,
+// item 2). When the pair is mirror-symmetric, every feature curve acts on its
+// mirror image too: a curve whose mirror is not already a feature (the left
+// profile, but not a front profile lying on the plane) gets a mirrored copy, so
+// the feature and surface steps treat both sides alike.
+#include <refit/features/feature_curves.hpp>
+
+#include <string>
+#include <vector>
+
+namespace refit {
+
+enum class SymmetryMode { Auto, X, None };
+
+/// Parses "auto", "x" or "none"; throws refit::Error otherwise.
+SymmetryMode parse_symmetry(const std::string& s);
+
+struct SymmetryCheck {
+  double plane_x = 0.0;        // the mirror plane x = plane_x (middle of body A's bounding box in x)
+  double garment_error = 0.0;  // 95th percentile distance from a mirrored garment vertex to the nearest garment vertex
+  double body_error = 0.0;     // the same for body A's vertices
+  double tolerance = 0.0;      // both errors must be at most this for Auto to detect symmetry
+  bool symmetric = false;      // used: forced by X, detected by Auto, never with None
+};
+
+/// Measures the pair's mirror error about x = middle of body A. tolerance: in
+/// the garment's units (Auto's threshold).
+SymmetryCheck check_symmetry(const Points& garment, const Points& body_a, double tolerance, SymmetryMode mode);
+
+/// p mirrored about x = c.
+Points mirror_x(const Points& p, double c);
+
+/// `curves` plus, for each curve whose mirror about x = c is not within
+/// `coincide` spacings of an existing curve (itself included), its mirrored
+/// copy named "<name>~mirror" (appended after all given curves, in their order).
+std::vector<FeatureCurve> add_mirrored_curves(std::vector<FeatureCurve> curves, double c, double coincide = 2.0);
+
+}  // namespace refit
