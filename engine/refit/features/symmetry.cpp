@@ -3,6 +3,7 @@
 #include <refit/body/centre_tree.hpp>
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
+#include <refit/features/curve_metrics.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -85,6 +86,46 @@ std::vector<FeatureCurve> add_mirrored_curves(std::vector<FeatureCurve> curves, 
     curves.push_back(std::move(mc));
   }
   return curves;
+}
+
+std::vector<Index> mirror_pairs(const Points& samples, double c, double tolerance) {
+  std::vector<Index> pairs(static_cast<std::size_t>(samples.rows()), kNoMirror);
+  if (samples.rows() == 0) return pairs;
+  const PointTree tree(samples);
+  for (Index i = 0; i < samples.rows(); ++i) {
+    const auto [j, d2] = tree.nearest(mirror_point(row3(samples, i), c));
+    if (std::sqrt(d2) <= tolerance) pairs[static_cast<std::size_t>(i)] = j;
+  }
+  return pairs;
+}
+
+void symmetrise(Points& points, const std::vector<Index>& pairs, double c) {
+  const Points before = points;
+  for (std::size_t i = 0; i < pairs.size(); ++i)
+    if (pairs[i] != kNoMirror) {
+      const Vec3 p = 0.5 * (row3(before, static_cast<Index>(i)) + mirror_point(row3(before, pairs[i]), c));
+      points.row(static_cast<Index>(i)) = p.transpose();
+    }
+}
+
+void symmetrise_curves(FeatureResult& result, const std::vector<Index>& pairs, double c) {
+  Index rows = 0;
+  for (const CurveResult& r : result.curves) rows += r.optimised.rows();
+  if (static_cast<std::size_t>(rows) != pairs.size()) throw Error("internal: mirror pairs do not match the feature samples");
+  Points all(rows, 3);
+  rows = 0;
+  for (const CurveResult& r : result.curves) {
+    all.middleRows(rows, r.optimised.rows()) = r.optimised;
+    rows += r.optimised.rows();
+  }
+  symmetrise(all, pairs, c);
+  rows = 0;
+  for (CurveResult& r : result.curves) {
+    r.optimised = all.middleRows(rows, r.optimised.rows());
+    rows += r.optimised.rows();
+    r.shape_error_result = shape_error(r.optimised, r.original, r.closed);
+    r.turning_angle_change_result_deg = turning_angle_change_deg(r.optimised, r.original, r.closed);
+  }
 }
 
 }  // namespace refit

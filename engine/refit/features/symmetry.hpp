@@ -5,6 +5,7 @@
 // profile, but not a front profile lying on the plane) gets a mirrored copy, so
 // the feature and surface steps treat both sides alike.
 #include <refit/features/feature_curves.hpp>
+#include <refit/features/shape_matching.hpp>
 
 #include <string>
 #include <vector>
@@ -35,5 +36,18 @@ Points mirror_x(const Points& p, double c);
 /// `coincide` spacings of an existing curve (itself included), its mirrored
 /// copy named "<name>~mirror" (appended after all given curves, in their order).
 std::vector<FeatureCurve> add_mirrored_curves(std::vector<FeatureCurve> curves, double c, double coincide = 2.0);
+
+/// For each sample of the concatenated curves `samples` (original garment), the
+/// sample nearest its mirror about x = c, or -1 when none is within `tolerance`.
+inline constexpr Index kNoMirror = static_cast<Index>(-1);
+std::vector<Index> mirror_pairs(const Points& samples, double c, double tolerance);
+
+/// Makes `points` (rows matching mirror_pairs' samples) mirror-symmetric: each
+/// paired row becomes the mean of itself and its partner's mirror image.
+void symmetrise(Points& points, const std::vector<Index>& pairs, double c);
+
+/// symmetrise() on the optimised samples of every curve (concatenated in order,
+/// as mirror_pairs' samples), then their shape figures measured again.
+void symmetrise_curves(FeatureResult& result, const std::vector<Index>& pairs, double c);
 
 }  // namespace refit

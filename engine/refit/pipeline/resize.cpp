@@ -7,6 +7,8 @@
 #include <refit/pipeline/resize.hpp>
 #include <refit/pipeline/units.hpp>
 
+#include <limits>
+
 namespace refit {
 
 namespace {
@@ -102,6 +104,18 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
                         {"body_a_error", sym.body_error},  {"tolerance", sym.tolerance},
                         {"symmetric", sym.symmetric},      {"mirrored_features", mirrored}};
     features_ = bind_features(body_a_, std::move(curves), options_.shape_matching);
+    if (sym.symmetric) {
+      // Pairs only where the mirror image is a sample (the mirrored copies, a hem, a profile on the plane).
+      double spacing = std::numeric_limits<double>::infinity();
+      std::vector<const Points*> samples;
+      for (const FeatureCurve& c : features_->model.curves) {
+        samples.push_back(&c.samples);
+        spacing = std::min(spacing, c.spacing());
+      }
+      mirror_x_ = sym.plane_x;
+      feature_mirror_ = mirror_pairs(concat_rows(samples), mirror_x_, 0.5 * spacing);
+      garment_mirror_ = mirror_pairs(garment_->positions, mirror_x_, sym.tolerance);
+    }
     bind_report_["features"] = clock.ms();
   }
   if (options_.stage == Stage::Full) {
@@ -157,6 +171,7 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
   if (features_) {
     progress.stage("optimising " + std::to_string(features_->model.curves.size()) + " feature curves");
     curves = optimise_features(*features_, frames_b, distance_b);
+    if (!feature_mirror_.empty()) symmetrise_curves(curves, feature_mirror_, mirror_x_);
     timings["features"] = clock.ms();
     report["symmetry"] = symmetry_report_;
     nlohmann::json& list = report["features"];
@@ -192,6 +207,9 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
     timings["surface"] = clock.ms();
     report["surface"] = surface_report(s.stats);
     result.positions = std::move(s.positions);
+    // The agents' solve is not exactly mirror-symmetric (its ordering and blends are not):
+    // a symmetric pair gives a symmetric garment.
+    if (!garment_mirror_.empty()) symmetrise(result.positions, garment_mirror_, mirror_x_);
     if (s.stats.anchored > 0)
       result.warnings.push_back(std::to_string(s.stats.anchored) + " agents in " + std::to_string(s.stats.anchored_groups) +
                                 " groups with no fixed agent were anchored at their warped positions");

@@ -69,6 +69,9 @@ class GarmentBinding {
   std::shared_ptr<const Garment> garment_;
   ResizeOptions options_;
   nlohmann::json symmetry_report_;
+  std::vector<Index> feature_mirror_;  // per feature sample (all curves, in order): its mirror partner, or kNoMirror
+  std::vector<Index> garment_mirror_;  // per garment vertex, the same (empty when not symmetric)
+  double mirror_x_ = 0.0;
   ReferenceBody body_a_;
   WarpBinding warp_;
   std::optional<FeatureBinding> features_;
