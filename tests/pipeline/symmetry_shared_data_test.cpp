@@ -1,7 +1,8 @@
 // Issue 13 item 2 on real data: the MakeHuman skirt (mirror-symmetric about x = 0,
 // like every shared body) with a hem, a front and only a LEFT profile
 // (bench/quality/features/skirt.json). The left profile's mirror becomes a
-// feature, and the written garment is at most 0.1 cm less symmetric than the warp.
+// feature, and the written garment is at most 0.1 cm less symmetric than the warp;
+// a lopsided body B is not forced into symmetry.
 // Skips when ../shared/data is absent.
 #include "support/test_support.hpp"
 
@@ -50,7 +51,15 @@ TEST(SymmetrySharedData, OneSidedProfileKeepsSkirtSymmetric) {
                 r.report.at("surface").at("feature_gap").get<double>());
     EXPECT_LE(result, warp + 0.1) << target;
     EXPECT_LE(r.report.at("surface").at("feature_gap").get<double>(), 0.05) << target;
+    EXPECT_TRUE(sym.at("symmetrised").get<bool>()) << target;
   }
+  // A body B that is not symmetric (its left side 5 % wider) is not forced into symmetry.
+  BodyMesh lopsided = read_body(data + "/bodies/F_heavier.obj");
+  for (Eigen::Index i = 0; i < lopsided.vertices.rows(); ++i)
+    if (lopsided.vertices(i, 0) > 0.0) lopsided.vertices(i, 0) *= 1.05;
+  const ResizeResult r = binding.resize(lopsided);
+  EXPECT_GT(r.report.at("symmetry").at("body_b_error").get<double>(), 0.5);
+  EXPECT_FALSE(r.report.at("symmetry").at("symmetrised").get<bool>());
 }
 
 }  // namespace

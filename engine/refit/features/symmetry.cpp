@@ -108,6 +108,14 @@ void symmetrise(Points& points, const std::vector<Index>& pairs, double c) {
     }
 }
 
+double paired_mirror_error(const Points& points, const std::vector<Index>& pairs, double c) {
+  double worst = 0.0;
+  for (std::size_t i = 0; i < pairs.size(); ++i)
+    if (pairs[i] != kNoMirror)
+      worst = std::max(worst, (row3(points, static_cast<Index>(i)) - mirror_point(row3(points, pairs[i]), c)).norm());
+  return worst;
+}
+
 void symmetrise_curves(FeatureResult& result, const std::vector<Index>& pairs, double c) {
   Index rows = 0;
   for (const CurveResult& r : result.curves) rows += r.optimised.rows();

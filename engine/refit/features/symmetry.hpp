@@ -46,6 +46,10 @@ std::vector<Index> mirror_pairs(const Points& samples, double c, double toleranc
 /// paired row becomes the mean of itself and its partner's mirror image.
 void symmetrise(Points& points, const std::vector<Index>& pairs, double c);
 
+/// Largest distance between a row of `points` and the mirror image about x = c
+/// of its partner (rows without one are skipped): 0 for a symmetric set.
+double paired_mirror_error(const Points& points, const std::vector<Index>& pairs, double c);
+
 /// symmetrise() on the optimised samples of every curve (concatenated in order,
 /// as mirror_pairs' samples), then their shape figures measured again.
 void symmetrise_curves(FeatureResult& result, const std::vector<Index>& pairs, double c);

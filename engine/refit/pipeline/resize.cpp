@@ -115,6 +115,8 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
       mirror_x_ = sym.plane_x;
       feature_mirror_ = mirror_pairs(concat_rows(samples), mirror_x_, 0.5 * spacing);
       garment_mirror_ = mirror_pairs(garment_->positions, mirror_x_, sym.tolerance);
+      body_mirror_ = mirror_pairs(body_a_.mesh().vertices, mirror_x_, sym.tolerance);
+      mirror_tolerance_ = sym.tolerance;
     }
     bind_report_["features"] = clock.ms();
   }
@@ -168,12 +170,21 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
 
   // Step 2: feature curves keep their shape (section 4).
   FeatureResult& curves = result.features;
+  bool symmetric_b = false;
   if (features_) {
     progress.stage("optimising " + std::to_string(features_->model.curves.size()) + " feature curves");
     curves = optimise_features(*features_, frames_b, distance_b);
-    if (!feature_mirror_.empty()) symmetrise_curves(curves, feature_mirror_, mirror_x_);
+    // Symmetrise only when body B is symmetric too (the same vertices as body A's, mirrored).
+    if (!feature_mirror_.empty()) {
+      const double body_b_error = paired_mirror_error(body_b.vertices, body_mirror_, mirror_x_);
+      symmetric_b = body_b_error <= mirror_tolerance_;
+      report["symmetry"] = symmetry_report_;
+      report["symmetry"]["body_b_error"] = body_b_error;
+      report["symmetry"]["symmetrised"] = symmetric_b;
+    }
+    if (symmetric_b) symmetrise_curves(curves, feature_mirror_, mirror_x_);
     timings["features"] = clock.ms();
-    report["symmetry"] = symmetry_report_;
+    if (!report.contains("symmetry")) report["symmetry"] = symmetry_report_;
     nlohmann::json& list = report["features"];
     list = nlohmann::json::array();
     for (const CurveResult& c : curves.curves) {
@@ -209,7 +220,7 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
     result.positions = std::move(s.positions);
     // The agents' solve is not exactly mirror-symmetric (its ordering and blends are not):
     // a symmetric pair gives a symmetric garment.
-    if (!garment_mirror_.empty()) symmetrise(result.positions, garment_mirror_, mirror_x_);
+    if (symmetric_b) symmetrise(result.positions, garment_mirror_, mirror_x_);
     if (s.stats.anchored > 0)
       result.warnings.push_back(std::to_string(s.stats.anchored) + " agents in " + std::to_string(s.stats.anchored_groups) +
                                 " groups with no fixed agent were anchored at their warped positions");

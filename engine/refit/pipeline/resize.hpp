@@ -71,7 +71,8 @@ class GarmentBinding {
   nlohmann::json symmetry_report_;
   std::vector<Index> feature_mirror_;  // per feature sample (all curves, in order): its mirror partner, or kNoMirror
   std::vector<Index> garment_mirror_;  // per garment vertex, the same (empty when not symmetric)
-  double mirror_x_ = 0.0;
+  std::vector<Index> body_mirror_;     // per body A vertex, the same: checks that body B is symmetric too
+  double mirror_x_ = 0.0, mirror_tolerance_ = 0.0;
   ReferenceBody body_a_;
   WarpBinding warp_;
   std::optional<FeatureBinding> features_;
