@@ -14,19 +14,24 @@ namespace {
 Vec3 mirror_point(const Vec3& p, double c) { return {2.0 * c - p.x(), p.y(), p.z()}; }
 Vec3 mirror_dir(const Vec3& d) { return {-d.x(), d.y(), d.z()}; }
 
-// 95th percentile of the distance from each mirrored point to the nearest point of the set:
-// robust to a few one-sided details (a button, a label).
-double mirror_error(const Points& p, double c) {
-  if (p.rows() == 0) return 0.0;
-  const PointTree tree(p);
+// 95th percentile: robust to a few one-sided details (a button, a label).
+double percentile95(std::vector<double> d) {
+  if (d.empty()) return 0.0;
+  const std::size_t k = std::min(d.size() - 1, static_cast<std::size_t>(0.95 * static_cast<double>(d.size())));
+  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(k), d.end());
+  return d[k];
+}
+
+// Per point, the distance from its mirror image to the nearest point of the set.
+std::vector<double> vertex_mirror_distance(const Points& p, double c) {
   const std::size_t n = static_cast<std::size_t>(p.rows());
   std::vector<double> d(n);
+  if (n == 0) return d;
+  const PointTree tree(p);
   parallel_for(0, n, 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) d[i] = std::sqrt(tree.nearest(mirror_point(row3(p, static_cast<Index>(i)), c)).second);
   });
-  const std::size_t k = std::min(n - 1, static_cast<std::size_t>(0.95 * static_cast<double>(n)));
-  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(k), d.end());
-  return d[k];
+  return d;
 }
 
 }  // namespace
@@ -44,13 +49,18 @@ Points mirror_x(const Points& p, double c) {
   return m;
 }
 
-SymmetryCheck check_symmetry(const Points& garment, const Points& body_a, double tolerance, SymmetryMode mode) {
+double mirror_plane_x(const Points& body_a) {
+  return body_a.rows() > 0 ? 0.5 * (body_a.col(0).minCoeff() + body_a.col(0).maxCoeff()) : 0.0;
+}
+
+SymmetryCheck check_symmetry(double plane_x, const std::vector<double>& garment_mirror_distance, const Points& body_a,
+                             double tolerance, SymmetryMode mode) {
   SymmetryCheck s;
   s.tolerance = tolerance;
-  if (body_a.rows() > 0) s.plane_x = 0.5 * (body_a.col(0).minCoeff() + body_a.col(0).maxCoeff());
+  s.plane_x = plane_x;
   if (mode == SymmetryMode::None) return s;
-  s.garment_error = mirror_error(garment, s.plane_x);
-  s.body_error = mirror_error(body_a, s.plane_x);
+  s.garment_error = percentile95(garment_mirror_distance);
+  s.body_error = percentile95(vertex_mirror_distance(body_a, plane_x));
   s.symmetric = mode == SymmetryMode::X || (s.garment_error <= tolerance && s.body_error <= tolerance);
   return s;
 }

@@ -18,16 +18,21 @@ enum class SymmetryMode { Auto, X, None };
 SymmetryMode parse_symmetry(const std::string& s);
 
 struct SymmetryCheck {
-  double plane_x = 0.0;        // the mirror plane x = plane_x (middle of body A's bounding box in x)
-  double garment_error = 0.0;  // 95th percentile distance from a mirrored garment vertex to the nearest garment vertex
-  double body_error = 0.0;     // the same for body A's vertices
+  double plane_x = 0.0;        // the mirror plane x = plane_x
+  double garment_error = 0.0;  // 95th percentile distance from a mirrored garment vertex to the garment's surface
+  double body_error = 0.0;     // 95th percentile distance from a mirrored body A vertex to the nearest body A vertex
   double tolerance = 0.0;      // both errors must be at most this for Auto to detect symmetry
   bool symmetric = false;      // used: forced by X, detected by Auto, never with None
 };
 
-/// Measures the pair's mirror error about x = middle of body A. tolerance: in
-/// the garment's units (Auto's threshold).
-SymmetryCheck check_symmetry(const Points& garment, const Points& body_a, double tolerance, SymmetryMode mode);
+/// The mirror plane's x: the middle of body A's bounding box in x.
+double mirror_plane_x(const Points& body_a);
+
+/// The pair's mirror error about x = plane_x. garment_mirror_distance: per garment
+/// vertex, the distance from its mirror image to the garment's surface (garment
+/// meshes need not be vertex-symmetric). tolerance: in the garment's units.
+SymmetryCheck check_symmetry(double plane_x, const std::vector<double>& garment_mirror_distance, const Points& body_a,
+                             double tolerance, SymmetryMode mode);
 
 /// p mirrored about x = c.
 Points mirror_x(const Points& p, double c);

@@ -94,7 +94,15 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
     clock.reset();
     progress.stage("sampling " + std::to_string(features.size()) + " feature curves");
     std::vector<FeatureCurve> curves = build_feature_curves(*garment_, features);
-    const SymmetryCheck sym = check_symmetry(garment_->positions, body_a_.mesh().vertices,
+    // Each garment vertex's mirror image, found on the garment's surface (meshes need not be vertex-symmetric).
+    const double plane_x = mirror_plane_x(body_a_.mesh().vertices);
+    SurfaceAttachment mirror_at;
+    std::vector<double> mirror_distance;
+    if (options_.symmetry != SymmetryMode::None) {
+      mirror_at = attach_points(*garment_, mirror_x(garment_->positions, plane_x));
+      for (Eigen::Index i = 0; i < mirror_at.offset.rows(); ++i) mirror_distance.push_back(mirror_at.offset.row(i).norm());
+    }
+    const SymmetryCheck sym = check_symmetry(plane_x, mirror_distance, body_a_.mesh().vertices,
                                              options_.symmetry_tolerance_cm * per_cm, options_.symmetry);
     const std::size_t given = curves.size();
     if (sym.symmetric) curves = add_mirrored_curves(std::move(curves), sym.plane_x);
@@ -114,7 +122,9 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
       }
       mirror_x_ = sym.plane_x;
       feature_mirror_ = mirror_pairs(concat_rows(samples), mirror_x_, 0.5 * spacing);
-      garment_mirror_ = mirror_pairs(garment_->positions, mirror_x_, sym.tolerance);
+      garment_mirror_ = std::move(mirror_at);
+      garment_paired_.resize(mirror_distance.size());
+      for (std::size_t i = 0; i < mirror_distance.size(); ++i) garment_paired_[i] = mirror_distance[i] <= sym.tolerance;
       body_mirror_ = mirror_pairs(body_a_.mesh().vertices, mirror_x_, sym.tolerance);
       mirror_tolerance_ = sym.tolerance;
     }
@@ -220,7 +230,11 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
     result.positions = std::move(s.positions);
     // The agents' solve is not exactly mirror-symmetric (its ordering and blends are not):
     // a symmetric pair gives a symmetric garment.
-    if (symmetric_b) symmetrise(result.positions, garment_mirror_, mirror_x_);
+    if (symmetric_b) {
+      const Points mirrored = mirror_x(carry(garment_mirror_, result.positions), mirror_x_);
+      for (Index i = 0; i < result.positions.rows(); ++i)
+        if (garment_paired_[i]) result.positions.row(i) = 0.5 * (result.positions.row(i) + mirrored.row(i));
+    }
     if (s.stats.anchored > 0)
       result.warnings.push_back(std::to_string(s.stats.anchored) + " agents in " + std::to_string(s.stats.anchored_groups) +
                                 " groups with no fixed agent were anchored at their warped positions");

@@ -31,7 +31,7 @@ struct ResizeOptions {
   WarpOptions warp;
   ShapeMatchingOptions shape_matching;
   SymmetryMode symmetry = SymmetryMode::Auto;  // mirror one-sided features about x = c (docs/features.md)
-  double symmetry_tolerance_cm = 0.5;          // Auto: largest mirror error (95th percentile) of garment and body A
+  double symmetry_tolerance_cm = 1.0;          // Auto: largest mirror error (95th percentile) of garment and body A
   SurfaceOptions surface;      // epsilon and voxel in cm here; converted to garment units
   bool collision = true;       // push vertices inside body B out (beyond the paper)
   double clearance_cm = 0.2;   // ... to this distance outside the body
@@ -70,7 +70,8 @@ class GarmentBinding {
   ResizeOptions options_;
   nlohmann::json symmetry_report_;
   std::vector<Index> feature_mirror_;  // per feature sample (all curves, in order): its mirror partner, or kNoMirror
-  std::vector<Index> garment_mirror_;  // per garment vertex, the same (empty when not symmetric)
+  SurfaceAttachment garment_mirror_;   // per garment vertex, its mirror image on the garment's surface
+  std::vector<std::uint8_t> garment_paired_;  // ... when that image is within the symmetry tolerance
   std::vector<Index> body_mirror_;     // per body A vertex, the same: checks that body B is symmetric too
   double mirror_x_ = 0.0, mirror_tolerance_ = 0.0;
   ReferenceBody body_a_;
