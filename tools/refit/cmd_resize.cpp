@@ -17,7 +17,7 @@ namespace refit::cli {
 namespace {
 
 struct ResizeArgs {
-  std::string garment, from, out, out_dir, report, features, curves_out, units = "cm", stage = "full";
+  std::string garment, from, out, out_dir, report, features, curves_out, units = "cm", stage = "full", symmetry = "auto";
   std::vector<std::string> to;
   std::size_t threads = 0, max_triangles = WarpOptions{}.max_triangles;
   bool quiet = false, metrics = false, paper_closeness = false, no_shape_control = false, no_collision = false, encode_on_warped = false,
@@ -59,6 +59,7 @@ int run(const ResizeArgs& a) {
     options.surface.layers = false;
   }
   options.collision = !a.no_collision;
+  options.symmetry = parse_symmetry(a.symmetry);
   options.metrics = a.metrics;
   options.clearance_cm = a.clearance;
   if (!a.curves_out.empty() && a.features.empty()) throw Error("--curves-out needs --features");
@@ -172,6 +173,10 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
   app.add_flag("--paper-surface", a->paper_surface,
                "Surface step as the paper: fan-normal frames, eq. 4 blend of the warped vertices, no smoothing, no layers, "
                "--feature-zone 0");
+  app.add_option("--symmetry", a->symmetry,
+                 "auto: mirror each one-sided feature about x = c when garment and body A are mirror-symmetric; "
+                 "x: always; none: never (docs/features.md)")
+      ->capture_default_str();
   app.add_flag("--no-collision", a->no_collision, "Do not push vertices inside body B out");
   app.add_option("--clearance", a->clearance, "Collision clearance outside body B in cm")->capture_default_str();
   app.add_flag("--metrics", a->metrics, "Add fit, penetration and surface metrics of the warp and the result to the report");

@@ -7,6 +7,8 @@
 #include <refit/pipeline/resize.hpp>
 #include <refit/pipeline/units.hpp>
 
+#include <limits>
+
 namespace refit {
 
 namespace {
@@ -88,10 +90,45 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
   bind_report_["warp"] = clock.ms();
 
   if (options_.stage == Stage::Warp) return;
+  // Each garment vertex's mirror image, found on the garment's surface (meshes need not be vertex-symmetric).
+  const double plane_x = mirror_plane_x(body_a_.mesh().vertices);
+  SurfaceAttachment mirror_at;
+  std::vector<double> mirror_distance;
+  if (options_.symmetry != SymmetryMode::None) {
+    mirror_at = attach_points(*garment_, mirror_x(garment_->positions, plane_x));
+    for (Eigen::Index i = 0; i < mirror_at.offset.rows(); ++i) mirror_distance.push_back(mirror_at.offset.row(i).norm());
+  }
+  const SymmetryCheck sym = check_symmetry(plane_x, mirror_distance, body_a_.mesh().vertices,
+                                           options_.symmetry_tolerance_cm * per_cm, options_.symmetry);
+  if (sym.symmetric) {
+    mirror_x_ = sym.plane_x;
+    mirror_tolerance_ = sym.tolerance;
+    garment_mirror_ = std::move(mirror_at);
+    garment_paired_.resize(mirror_distance.size());
+    for (std::size_t i = 0; i < mirror_distance.size(); ++i) garment_paired_[i] = mirror_distance[i] <= sym.tolerance;
+    body_mirror_ = mirror_pairs(body_a_.mesh().vertices, mirror_x_, sym.tolerance);
+  }
+  symmetry_report_ = {{"plane_x", sym.plane_x},          {"garment_error", sym.garment_error},
+                      {"body_a_error", sym.body_error},  {"tolerance", sym.tolerance},
+                      {"symmetric", sym.symmetric},      {"mirrored_features", nlohmann::json::array()}};
   if (!features.empty()) {
     clock.reset();
     progress.stage("sampling " + std::to_string(features.size()) + " feature curves");
-    features_ = bind_features(body_a_, build_feature_curves(*garment_, features), options_.shape_matching);
+    std::vector<FeatureCurve> curves = build_feature_curves(*garment_, features);
+    const std::size_t given = curves.size();
+    if (sym.symmetric) curves = add_mirrored_curves(std::move(curves), sym.plane_x);
+    for (std::size_t i = given; i < curves.size(); ++i) symmetry_report_["mirrored_features"].push_back(curves[i].name);
+    features_ = bind_features(body_a_, std::move(curves), options_.shape_matching);
+    if (sym.symmetric) {
+      // Pairs only where the mirror image is a sample (the mirrored copies, a hem, a profile on the plane).
+      double spacing = std::numeric_limits<double>::infinity();
+      std::vector<const Points*> samples;
+      for (const FeatureCurve& c : features_->model.curves) {
+        samples.push_back(&c.samples);
+        spacing = std::min(spacing, c.spacing());
+      }
+      feature_mirror_ = mirror_pairs(concat_rows(samples), mirror_x_, 0.5 * spacing);
+    }
     bind_report_["features"] = clock.ms();
   }
   if (options_.stage == Stage::Full) {
@@ -143,10 +180,21 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
   const auto distance_b = [&](const Vec3& p) { return surface_b.closest(p).distance; };
 
   // Step 2: feature curves keep their shape (section 4).
+  // Symmetrise only when body B is symmetric too (the same vertices as body A's, mirrored).
+  bool symmetric_b = false;
+  report["symmetry"] = symmetry_report_;
+  if (!body_mirror_.empty()) {
+    const double body_b_error = paired_mirror_error(body_b.vertices, body_mirror_, mirror_x_);
+    symmetric_b = body_b_error <= mirror_tolerance_;
+    report["symmetry"]["body_b_error"] = body_b_error;
+    report["symmetry"]["symmetrised"] = symmetric_b;
+  }
+
   FeatureResult& curves = result.features;
   if (features_) {
     progress.stage("optimising " + std::to_string(features_->model.curves.size()) + " feature curves");
     curves = optimise_features(*features_, frames_b, distance_b);
+    if (symmetric_b && !feature_mirror_.empty()) symmetrise_curves(curves, feature_mirror_, mirror_x_);
     timings["features"] = clock.ms();
     nlohmann::json& list = report["features"];
     list = nlohmann::json::array();
@@ -181,6 +229,13 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
     timings["surface"] = clock.ms();
     report["surface"] = surface_report(s.stats);
     result.positions = std::move(s.positions);
+    // The agents' solve is not exactly mirror-symmetric (its ordering and blends are not):
+    // a symmetric pair gives a symmetric garment.
+    if (symmetric_b) {
+      const Points mirrored = mirror_x(carry(garment_mirror_, result.positions), mirror_x_);
+      for (Index i = 0; i < result.positions.rows(); ++i)
+        if (garment_paired_[i]) result.positions.row(i) = 0.5 * (result.positions.row(i) + mirrored.row(i));
+    }
     if (s.stats.anchored > 0)
       result.warnings.push_back(std::to_string(s.stats.anchored) + " agents in " + std::to_string(s.stats.anchored_groups) +
                                 " groups with no fixed agent were anchored at their warped positions");

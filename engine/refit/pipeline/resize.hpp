@@ -7,6 +7,7 @@
 #include <refit/core/progress.hpp>
 #include <refit/features/feature_file.hpp>
 #include <refit/features/shape_matching.hpp>
+#include <refit/features/symmetry.hpp>
 #include <refit/metrics/metrics.hpp>
 #include <refit/surface/surface.hpp>
 #include <refit/warp/warp.hpp>
@@ -29,6 +30,8 @@ struct ResizeOptions {
   Stage stage = Stage::Full;
   WarpOptions warp;
   ShapeMatchingOptions shape_matching;
+  SymmetryMode symmetry = SymmetryMode::Auto;  // mirror one-sided features about x = c (docs/features.md)
+  double symmetry_tolerance_cm = 1.0;          // Auto: largest mirror error (95th percentile) of garment and body A
   SurfaceOptions surface;      // epsilon and voxel in cm here; converted to garment units
   bool collision = true;       // push vertices inside body B out (beyond the paper)
   double clearance_cm = 0.2;   // ... to this distance outside the body
@@ -65,6 +68,12 @@ class GarmentBinding {
  private:
   std::shared_ptr<const Garment> garment_;
   ResizeOptions options_;
+  nlohmann::json symmetry_report_;
+  std::vector<Index> feature_mirror_;  // per feature sample (all curves, in order): its mirror partner, or kNoMirror
+  SurfaceAttachment garment_mirror_;   // per garment vertex, its mirror image on the garment's surface
+  std::vector<std::uint8_t> garment_paired_;  // ... when that image is within the symmetry tolerance
+  std::vector<Index> body_mirror_;     // per body A vertex, the same: checks that body B is symmetric too
+  double mirror_x_ = 0.0, mirror_tolerance_ = 0.0;
   ReferenceBody body_a_;
   WarpBinding warp_;
   std::optional<FeatureBinding> features_;

@@ -1,0 +1,62 @@
+#pragma once
+// Left/right symmetry of a garment and body A about a plane x = c (issue 13,
+// item 2). When the pair is mirror-symmetric, every feature curve acts on its
+// mirror image too: a curve whose mirror is not already a feature (the left
+// profile, but not a front profile lying on the plane) gets a mirrored copy, so
+// the feature and surface steps treat both sides alike.
+#include <refit/features/feature_curves.hpp>
+#include <refit/features/shape_matching.hpp>
+
+#include <string>
+#include <vector>
+
+namespace refit {
+
+enum class SymmetryMode { Auto, X, None };
+
+/// Parses "auto", "x" or "none"; throws refit::Error otherwise.
+SymmetryMode parse_symmetry(const std::string& s);
+
+struct SymmetryCheck {
+  double plane_x = 0.0;        // the mirror plane x = plane_x
+  double garment_error = 0.0;  // 95th percentile distance from a mirrored garment vertex to the garment's surface
+  double body_error = 0.0;     // 95th percentile distance from a mirrored body A vertex to the nearest body A vertex
+  double tolerance = 0.0;      // both errors must be at most this for Auto to detect symmetry
+  bool symmetric = false;      // used: forced by X, detected by Auto, never with None
+};
+
+/// The mirror plane's x: the middle of body A's bounding box in x.
+double mirror_plane_x(const Points& body_a);
+
+/// The pair's mirror error about x = plane_x. garment_mirror_distance: per garment
+/// vertex, the distance from its mirror image to the garment's surface (garment
+/// meshes need not be vertex-symmetric). tolerance: in the garment's units.
+SymmetryCheck check_symmetry(double plane_x, const std::vector<double>& garment_mirror_distance, const Points& body_a,
+                             double tolerance, SymmetryMode mode);
+
+/// p mirrored about x = c.
+Points mirror_x(const Points& p, double c);
+
+/// `curves` plus, for each curve whose mirror about x = c is not within
+/// `coincide` spacings of an existing curve (itself included), its mirrored
+/// copy named "<name>~mirror" (appended after all given curves, in their order).
+std::vector<FeatureCurve> add_mirrored_curves(std::vector<FeatureCurve> curves, double c, double coincide = 2.0);
+
+/// For each sample of the concatenated curves `samples` (original garment), the
+/// sample nearest its mirror about x = c, or -1 when none is within `tolerance`.
+inline constexpr Index kNoMirror = static_cast<Index>(-1);
+std::vector<Index> mirror_pairs(const Points& samples, double c, double tolerance);
+
+/// Makes `points` (rows matching mirror_pairs' samples) mirror-symmetric: each
+/// paired row becomes the mean of itself and its partner's mirror image.
+void symmetrise(Points& points, const std::vector<Index>& pairs, double c);
+
+/// Largest distance between a row of `points` and the mirror image about x = c
+/// of its partner (rows without one are skipped): 0 for a symmetric set.
+double paired_mirror_error(const Points& points, const std::vector<Index>& pairs, double c);
+
+/// symmetrise() on the optimised samples of every curve (concatenated in order,
+/// as mirror_pairs' samples), then their shape figures measured again.
+void symmetrise_curves(FeatureResult& result, const std::vector<Index>& pairs, double c);
+
+}  // namespace refit

@@ -1,0 +1,110 @@
+// Mirror symmetry about x = c (issue 13 item 2), on hand-made points and curves.
+#include <refit/core/error.hpp>
+#include <refit/features/bspline.hpp>
+#include <refit/features/symmetry.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace refit;
+
+namespace {
+
+// A symmetric cloud about x = 1: pairs (1 +- a, y, z).
+Points symmetric_cloud() {
+  Points p(40, 3);
+  for (Eigen::Index i = 0; i < 20; ++i) {
+    const double a = 0.3 + 0.1 * static_cast<double>(i), y = std::sin(static_cast<double>(i)), z = 0.05 * static_cast<double>(i * i);
+    p.row(2 * i) << 1.0 + a, y, z;
+    p.row(2 * i + 1) << 1.0 - a, y, z;
+  }
+  return p;
+}
+
+// An open arc in the plane z = 0, right of x = 0.
+FeatureCurve side_curve() {
+  Points corners(3, 3);
+  corners << 2.0, 0.0, 0.0, 3.0, 1.0, 0.0, 2.5, 3.0, 0.0;
+  return make_feature_curve("left", resample_polyline(corners, 30, false), false,
+                            FeaturePlane::from_point_normal(Vec3(2, 0, 0), Vec3::UnitZ()));
+}
+
+// An open curve in the mirror plane x = 0.
+FeatureCurve centre_curve() {
+  Points corners(3, 3);
+  corners << 0.0, 0.0, 1.0, 0.0, 1.0, 1.5, 0.0, 3.0, 1.2;
+  return make_feature_curve("front", resample_polyline(corners, 30, false), false,
+                            FeaturePlane::from_point_normal(Vec3::Zero(), Vec3::UnitX()));
+}
+
+}  // namespace
+
+TEST(Symmetry, ParsesModes) {
+  EXPECT_EQ(parse_symmetry("auto"), SymmetryMode::Auto);
+  EXPECT_EQ(parse_symmetry("x"), SymmetryMode::X);
+  EXPECT_EQ(parse_symmetry("none"), SymmetryMode::None);
+  EXPECT_THROW(parse_symmetry("y"), Error);
+}
+
+TEST(Symmetry, DetectsSymmetricPairAndRejectsAsymmetricOne) {
+  const Points body = symmetric_cloud();
+  EXPECT_NEAR(mirror_plane_x(body), 1.0, 1e-12);
+  const std::vector<double> exact(30, 0.0);
+  const SymmetryCheck s = check_symmetry(1.0, exact, body, 0.01, SymmetryMode::Auto);
+  EXPECT_DOUBLE_EQ(s.plane_x, 1.0);
+  EXPECT_LT(s.body_error, 1e-12);
+  EXPECT_TRUE(s.symmetric);
+
+  // The garment: its 95th percentile decides (a few one-sided vertices pass, many do not).
+  std::vector<double> few(100, 0.0), many(100, 0.0);
+  for (int i = 0; i < 3; ++i) few[static_cast<std::size_t>(i)] = 5.0;
+  for (int i = 0; i < 10; ++i) many[static_cast<std::size_t>(i)] = 5.0;
+  EXPECT_TRUE(check_symmetry(1.0, few, body, 0.01, SymmetryMode::Auto).symmetric);
+  const SymmetryCheck off = check_symmetry(1.0, many, body, 0.01, SymmetryMode::Auto);
+  EXPECT_DOUBLE_EQ(off.garment_error, 5.0);
+  EXPECT_FALSE(off.symmetric);
+  EXPECT_TRUE(check_symmetry(1.0, many, body, 0.01, SymmetryMode::X).symmetric);
+  EXPECT_FALSE(check_symmetry(1.0, exact, body, 0.01, SymmetryMode::None).symmetric);
+
+  // A body off the plane is not symmetric about it.
+  EXPECT_FALSE(check_symmetry(1.2, exact, body, 0.01, SymmetryMode::Auto).symmetric);
+}
+
+TEST(Symmetry, MirrorsOneSidedCurvesOnly) {
+  const std::vector<FeatureCurve> curves = add_mirrored_curves({centre_curve(), side_curve()}, 0.0);
+  ASSERT_EQ(curves.size(), 3u);  // the centre curve is its own mirror
+  const FeatureCurve& m = curves[2];
+  EXPECT_EQ(m.name, "left~mirror");
+  EXPECT_FALSE(m.closed);
+  ASSERT_EQ(m.samples.rows(), curves[1].samples.rows());
+  for (Eigen::Index i = 0; i < m.samples.rows(); ++i) {
+    EXPECT_DOUBLE_EQ(m.samples(i, 0), -curves[1].samples(i, 0));
+    EXPECT_DOUBLE_EQ(m.samples(i, 1), curves[1].samples(i, 1));
+  }
+  EXPECT_NEAR(m.plane.normal.dot(m.plane.axis_u.cross(m.plane.axis_v)), 1.0, 1e-12);  // right-handed
+  EXPECT_EQ(m.aux.rows(), curves[1].aux.rows());
+  for (Eigen::Index i = 0; i < m.samples.rows(); ++i) EXPECT_NEAR(m.plane.signed_distance(row3(m.samples, static_cast<Index>(i))), 0.0, 1e-9);
+  // Mirroring again adds nothing: every curve's mirror is now a feature.
+  EXPECT_EQ(add_mirrored_curves(curves, 0.0).size(), 3u);
+}
+
+TEST(Symmetry, SymmetriseMakesPairedRowsMirrorImages) {
+  const Points original = symmetric_cloud();
+  const std::vector<Index> pairs = mirror_pairs(original, 1.0, 1e-6);
+  for (std::size_t i = 0; i < pairs.size(); ++i) EXPECT_EQ(pairs[i], static_cast<Index>(i ^ 1u));
+  Points moved = original;
+  for (Eigen::Index i = 0; i < moved.rows(); ++i) moved.row(i) += Eigen::RowVector3d(0.1 * std::cos(static_cast<double>(i)), 0.05 * static_cast<double>(i), 0.0);
+  symmetrise(moved, pairs, 1.0);
+  for (Eigen::Index i = 0; i < moved.rows(); ++i) {
+    const Eigen::Index j = i ^ 1;
+    EXPECT_NEAR(moved(i, 0), 2.0 - moved(j, 0), 1e-12);
+    EXPECT_NEAR(moved(i, 1), moved(j, 1), 1e-12);
+    EXPECT_NEAR(moved(i, 2), moved(j, 2), 1e-12);
+  }
+  // A row without a partner is left alone.
+  std::vector<Index> none(pairs.size(), kNoMirror);
+  Points kept = original;
+  symmetrise(kept, none, 1.0);
+  EXPECT_EQ(kept, original);
+}

@@ -1,0 +1,66 @@
+// Issue 13 item 2 on real data: the MakeHuman skirt (mirror-symmetric about x = 0,
+// like every shared body) with a hem, a front and only a LEFT profile
+// (bench/quality/features/skirt.json). The left profile's mirror becomes a
+// feature, and the written garment is at most 0.1 cm less symmetric than the warp;
+// a lopsided body B is not forced into symmetry.
+// Skips when ../shared/data is absent.
+#include "support/test_support.hpp"
+
+#include <refit/body/centre_tree.hpp>
+#include <refit/io/body_io.hpp>
+#include <refit/io/obj_garment.hpp>
+#include <refit/pipeline/resize.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+namespace refit {
+namespace {
+
+// Largest distance between a vertex and the mirror image (x -> -x) of its partner,
+// partners found on the original garment (vertices at each other's mirror image).
+double mirror_error(const Points& original, const Points& p) {
+  const PointTree tree(original);
+  double worst = 0.0;
+  for (Index i = 0; i < original.rows(); ++i) {
+    const Vec3 q = row3(original, i);
+    const auto [j, d2] = tree.nearest(Vec3(-q.x(), q.y(), q.z()));
+    if (d2 > 1e-6) continue;  // no partner
+    const Vec3 a = row3(p, i), b = row3(p, j);
+    worst = std::max(worst, (a - Vec3(-b.x(), b.y(), b.z())).norm());
+  }
+  return worst;
+}
+
+TEST(SymmetrySharedData, OneSidedProfileKeepsSkirtSymmetric) {
+  const std::string data = test::shared_data_dir();
+  if (data.empty()) GTEST_SKIP() << "../shared/data is absent: real-data symmetry test skipped";
+  auto garment = std::make_shared<const Garment>(read_garment_obj(data + "/garments/skirt_on_A_female.obj"));
+  const BodyMesh a = read_body(data + "/bodies/A_female.obj");
+  const GarmentBinding binding(garment, a, {},
+                               read_feature_file(std::string(REFIT_SOURCE_DIR) + "/bench/quality/features/skirt.json"));
+  for (const char* target : {"F_heavier", "F_thinner"}) {
+    const ResizeResult r = binding.resize(read_body(data + "/bodies/" + target + ".obj"));
+    const nlohmann::json& sym = r.report.at("symmetry");
+    EXPECT_TRUE(sym.at("symmetric").get<bool>()) << target;
+    EXPECT_EQ(sym.at("mirrored_features"), nlohmann::json::array({"left~mirror"})) << target;
+    const double warp = mirror_error(garment->positions, r.warped), result = mirror_error(garment->positions, r.positions);
+    std::printf("[ info ] skirt -> %s: mirror error %.3f cm (warp %.3f cm), feature gap %.4f cm\n", target, result, warp,
+                r.report.at("surface").at("feature_gap").get<double>());
+    EXPECT_LE(result, warp + 0.1) << target;
+    EXPECT_LE(r.report.at("surface").at("feature_gap").get<double>(), 0.05) << target;
+    EXPECT_TRUE(sym.at("symmetrised").get<bool>()) << target;
+  }
+  // A body B that is not symmetric (its left side 5 % wider) is not forced into symmetry.
+  BodyMesh lopsided = read_body(data + "/bodies/F_heavier.obj");
+  for (Eigen::Index i = 0; i < lopsided.vertices.rows(); ++i)
+    if (lopsided.vertices(i, 0) > 0.0) lopsided.vertices(i, 0) *= 1.05;
+  const ResizeResult r = binding.resize(lopsided);
+  EXPECT_GT(r.report.at("symmetry").at("body_b_error").get<double>(), 0.5);
+  EXPECT_FALSE(r.report.at("symmetry").at("symmetrised").get<bool>());
+}
+
+}  // namespace
+}  // namespace refit
