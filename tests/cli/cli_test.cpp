@@ -187,6 +187,18 @@ INSTANTIATE_TEST_SUITE_P(
                  "features", "far"}),
     [](const auto& info) { return info.param.name; });
 
+TEST(Cli, UsageErrorsExitTwoAndHelpDocumentsExitCodes) {
+  for (const std::string args : {"", "resize", "resize --no-such-option", "inspect a b c d"}) {
+    SCOPED_TRACE(args);
+    EXPECT_EQ(run_cli(args).exit_code, 2);
+  }
+  const auto help = run_cli("--help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.out.find("Exit codes: 0 ok, 1 bad input, 2 usage, 3 out of resources, 4 some bodies"),
+            std::string::npos)
+      << help.out;
+}
+
 TEST(Cli, InspectCountsTheSoup) {
   test::TempDir dir;
   mannequin::GarmentParams g;
