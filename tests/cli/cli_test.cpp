@@ -188,7 +188,12 @@ INSTANTIATE_TEST_SUITE_P(
     [](const auto& info) { return info.param.name; });
 
 TEST(Cli, UsageErrorsExitTwoAndHelpDocumentsExitCodes) {
-  for (const std::string args : {"", "resize", "resize --no-such-option", "inspect a b c d"}) {
+  for (const std::string args : {"", "resize", "resize --no-such-option", "inspect a b c d",
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --threads -1",
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --units furlong",
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --clearance nan",
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --clearance inf",
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --clearance 1e6"}) {
     SCOPED_TRACE(args);
     EXPECT_EQ(run_cli(args).exit_code, 2);
   }
