@@ -187,6 +187,23 @@ INSTANTIATE_TEST_SUITE_P(
                  "features", "far"}),
     [](const auto& info) { return info.param.name; });
 
+TEST(Cli, UsageErrorsExitTwoAndHelpDocumentsExitCodes) {
+  for (const std::string args : {"", "resize", "resize --no-such-option", "inspect a b c d",
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --threads -1",
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --units furlong",
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --clearance nan",
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --clearance inf",
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --clearance 1e6"}) {
+    SCOPED_TRACE(args);
+    EXPECT_EQ(run_cli(args).exit_code, 2);
+  }
+  const auto help = run_cli("--help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.out.find("Exit codes: 0 ok, 1 bad input, 2 usage, 3 out of resources, 4 some bodies"),
+            std::string::npos)
+      << help.out;
+}
+
 TEST(Cli, InspectCountsTheSoup) {
   test::TempDir dir;
   mannequin::GarmentParams g;

@@ -253,6 +253,7 @@ TEST(ObjRead, BadInputNamesFileLineAndProblem) {
       {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", 4, "vertex index 9 out of range"},
       {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", 4, "index 0 is invalid"},
       {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 -5 2\n", 4, "relative vertex index -5 out of range"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 -9223372036854775808 2\n", 4, "relative vertex index -9223372036854775808"},
       {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/4 2 3\n", 4, "texture coordinate index 4 out of range"},
       {"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//2 2 3\n", 5, "normal index 2 out of range"},
       {"v 0 0 0\nv 1 0 0\nf 1 2\n", 3, "face with 2 vertices"},

@@ -116,7 +116,9 @@ const Register reg("demo", "Generate the built-in example (mannequin pair and dr
                      app.add_option("--out-dir", a->out_dir, "Output folder")->capture_default_str();
                      app.add_option("--vertices", a->vertices, "Dress vertex count (approximate)")->capture_default_str();
                      add_body_options(app, a->body_b, "b-");
-                     app.add_option("--threads", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
+                     app.add_option("--threads", a->threads, "Worker threads (0 = all cores)")
+                         ->check(CLI::Range(0, 1024))
+                         ->capture_default_str();
                      app.add_flag("--quiet", a->quiet, "No progress on stderr");
                      return [a]() { return run(*a); };
                    });

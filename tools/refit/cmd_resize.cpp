@@ -26,6 +26,20 @@ struct ResizeArgs {
   double clearance = 0.2;
 };
 
+// A finite clearance from 0 to 10 cm: nan, inf or 1e6 would push the garment away (issue 17).
+std::string check_clearance(const std::string& s) {
+  double v = 0;
+  try {
+    std::size_t used = 0;
+    v = std::stod(s, &used);
+    if (used != s.size()) return "'" + s + "' is not a number";
+  } catch (const std::exception&) {
+    return "'" + s + "' is not a number";
+  }
+  if (!(v >= 0 && v <= 10)) return s + " is outside 0 to 10 cm";
+  return {};
+}
+
 Stage parse_stage(const std::string& s) {
   if (s == "warp") return Stage::Warp;
   if (s == "features") return Stage::Features;
@@ -138,9 +152,13 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
   app.add_option("--out", a->out, "Output OBJ (one body)");
   app.add_option("--out-dir", a->out_dir, "Output folder: writes DIR/<body-name>.obj per body");
   app.add_option("--report", a->report, "Write a JSON report");
-  app.add_option("--units", a->units, "Garment units: cm, mm, m or in")->capture_default_str();
+  app.add_option("--units", a->units, "Garment units: cm, mm, m or in")
+      ->check(CLI::IsMember({"cm", "mm", "m", "in"}))
+      ->capture_default_str();
   app.add_option("--stage", a->stage, "Stop after: warp, features or full")->capture_default_str();
-  app.add_option("--threads", a->threads, "Worker threads (0 = all cores)")->capture_default_str();
+  app.add_option("--threads", a->threads, "Worker threads (0 = all cores)")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
   app.add_option("--max-triangles", a->max_triangles, "Cap on the warp's triangle set per vertex")->capture_default_str();
   app.add_option("--features", a->features, "Feature curves (JSON) whose shape must survive");
   app.add_option("--curves-out", a->curves_out, "Write original, warped and optimised feature curves (OBJ l lines)");
@@ -178,7 +196,9 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
                  "x: always; none: never (docs/features.md)")
       ->capture_default_str();
   app.add_flag("--no-collision", a->no_collision, "Do not push vertices inside body B out");
-  app.add_option("--clearance", a->clearance, "Collision clearance outside body B in cm")->capture_default_str();
+  app.add_option("--clearance", a->clearance, "Collision clearance outside body B in cm (0 to 10)")
+      ->check(check_clearance)
+      ->capture_default_str();
   app.add_flag("--metrics", a->metrics, "Add fit, penetration and surface metrics of the warp and the result to the report");
   app.add_flag("--quiet", a->quiet, "No progress on stderr");
   return [a]() { return run(*a); };

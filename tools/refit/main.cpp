@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   CLI::App app{"refit: resize 3D garments to new bodies while keeping their designed shape"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "refit 0.1.0");
+  app.footer("Exit codes: 0 ok, 1 bad input, 2 usage, 3 out of resources, 4 some bodies of a batch failed.");
   auto& commands = registry();
   std::sort(commands.begin(), commands.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
   std::vector<std::pair<CLI::App*, std::function<int()>>> actions;
@@ -30,7 +31,8 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help/--version exit 0; every usage error exits 2 (not CLI11's own 104/105/...).
+    return app.exit(e) == 0 ? 0 : 2;
   }
   try {
     for (auto& [sub, action] : actions)

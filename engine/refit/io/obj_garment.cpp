@@ -157,7 +157,8 @@ class ChunkParser {
              std::to_string(total) + " " + what + (total == 1 ? "" : "s") + ")");
       return static_cast<Index>(raw - 1);
     }
-    if (static_cast<unsigned long long>(-raw) > cur)
+    // 0 - raw in unsigned arithmetic: -raw would overflow for LLONG_MIN.
+    if (0ULL - static_cast<unsigned long long>(raw) > cur)
       fail("relative " + std::string(what) + " index " + std::to_string(raw) + " out of range (only " +
            std::to_string(cur) + " " + what + (cur == 1 ? "" : "s") + " before this line)");
     return static_cast<Index>(static_cast<long long>(cur) + raw);
