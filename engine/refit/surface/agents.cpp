@@ -93,6 +93,12 @@ Index find_root(std::vector<Index>& parent, Index a) {
 }
 }  // namespace
 
+void check_finite(const Points& points, const std::string& what) {
+  for (Eigen::Index i = 0; i < points.rows(); ++i)
+    if (!points.row(i).allFinite())
+      throw Error("surface: " + what + " row " + std::to_string(i + 1) + " is not finite");
+}
+
 std::array<std::uint32_t, 3> VoxelGrid::cell(const Vec3& p) const {
   std::array<std::uint32_t, 3> c{};
   for (int d = 0; d < 3; ++d) {

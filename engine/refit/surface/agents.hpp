@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 namespace refit {
@@ -97,6 +98,10 @@ GarmentAgents select_agents(const Garment& g, const VoxelGrid& grid, const std::
 Csr build_one_rings(const Points& agents, double radius, const std::vector<std::uint32_t>& layer = {});
 
 /// k nearest points of the same layer (loose queries: of any layer).
+/// Throws refit::Error("surface: WHAT row N is not finite") for the first row of
+/// `points` that is not finite.
+void check_finite(const Points& points, const std::string& what);
+
 class LayerTrees {
  public:
   LayerTrees(const Points& points, const std::vector<std::uint32_t>& layer);

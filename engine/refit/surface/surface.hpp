@@ -13,6 +13,7 @@
 #include <refit/core/garment.hpp>
 #include <refit/surface/agent_frames.hpp>
 #include <refit/surface/agent_system.hpp>
+#include <refit/surface/coarse_levels.hpp>
 
 #include <functional>
 #include <memory>
@@ -203,22 +204,25 @@ class SurfaceBinding {
   const SurfaceStats& bind_stats() const { return stats_; }
 
  private:
-  // A coarser level of the coarse-to-fine start: a subset of the agents (every
-  // feature agent, and per voxel of the coarser grid the agent nearest its
-  // centre) with its own one-rings, encoding and schedule.
-  struct Level {
-    std::vector<Index> agent;      // fine storage slot of each agent of the level (level storage order)
-    Csr ring;
-    AgentRows rows;
-    BlockSchedule schedule;
-    std::vector<Index> group;      // connected group (one-ring graph of the level)
-    Csr up;                        // per agent of the next finer level: the level's agents it interpolates from
-    std::vector<float> up_weight;  // parallel to up.indices
-  };
-
-  // V-cycles on the fine system with aggregation coarse levels (see surface.cpp).
+  // V-cycles on the fine system with aggregation coarse levels (solver.cpp).
   SolveReport solve_multigrid(const AgentRows& rows, const Points& h, const std::vector<std::uint8_t>& free, Points& x,
                               const SolveOptions& solve, bool krylov, int* krylov_iterations) const;
+  // The steps of apply (surface.cpp, reconstruct.cpp; each documented where defined).
+  Points coarse_to_fine_start(const Points& before, const Points& target_of, const std::vector<std::uint8_t>& fixed,
+                              const std::vector<Eigen::Matrix3d>& turn, const std::vector<std::uint8_t>& fine_free,
+                              const SolveOptions& solve, int& coarse_iterations) const;
+  std::size_t follow_anchored(const Points& before, const std::vector<std::uint8_t>& fixed,
+                              const std::vector<std::uint8_t>& fr, Points& x,
+                              std::vector<std::uint8_t>& anchored_kept) const;
+  void smooth_displacements(const Points& before, const std::vector<std::uint8_t>& fr, Points& x) const;
+  Points reconstruct(const Points& warped, const Points& before, const Points& x,
+                     const std::vector<std::uint8_t>& anchored_kept, bool some_anchored_kept) const;
+  std::vector<std::uint8_t> keep_near_vertices(const Points& warped, const Points& before,
+                                               const std::vector<double>& body_distance,
+                                               const std::function<double(const Vec3&)>& distance,
+                                               Points& positions) const;
+  // Each vertex's agents within reach and blend weights (bind; reconstruct.cpp).
+  void bind_vertex_blends(const Points& positions, const std::vector<std::uint32_t>& vertex_layer);
 
   SurfaceOptions options_;
   double h_ = 0.0;
@@ -244,7 +248,7 @@ class SurfaceBinding {
   std::vector<float> reach_weight_;  // smooth_blend: normalised blend weights, parallel to reach_.indices
   std::vector<Index> nearest_;       // per garment vertex: nearest agent (used when reach is empty)
   Points original_vertices_;         // emit_from_original: the garment's original positions
-  std::vector<Level> levels_;        // coarser levels, finest first
+  std::vector<CoarseLevel> levels_;  // coarser levels, finest first (coarse_levels.hpp)
   SurfaceStats stats_;
 };
 

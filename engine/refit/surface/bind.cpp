@@ -1,0 +1,197 @@
+// Binding the surface step on the original garment: samples and agents, their
+// one-rings and storage order, the features' zone, the encoding (eqs. 10-12)
+// and the coarse levels. The vertex blends are bound in reconstruct.cpp.
+#include <refit/core/error.hpp>
+#include <refit/core/progress.hpp>
+#include <refit/surface/agents.hpp>
+#include <refit/surface/coarse_levels.hpp>
+#include <refit/surface/surface.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace refit {
+
+namespace {
+
+void check_options(const SurfaceOptions& o) {
+  auto bad = [](const std::string& m) { return Error("surface: " + m); };
+  if (!(o.voxel >= 0.0) || !std::isfinite(o.voxel)) throw bad("voxel size must be 0 (auto) or positive");
+  if (o.voxel == 0.0 && o.agent_budget == 0) throw bad("agent budget must be at least 1");
+  if (!(o.epsilon >= 0.0)) throw bad("epsilon must be non-negative");
+  if (o.max_iterations < 0) throw bad("max iterations must be non-negative");
+  if (!(o.tolerance >= 0.0)) throw bad("tolerance must be non-negative");
+  if (!(o.relaxation > 0.0 && o.relaxation < 2.0)) throw bad("relaxation must lie in (0, 2)");
+  if (!(o.reach_voxels > 0.0) || !std::isfinite(o.reach_voxels)) throw bad("reach must be positive");
+  if (!(o.ring_radius_voxels > 0.0) || !std::isfinite(o.ring_radius_voxels)) throw bad("one-ring radius must be positive");
+  if (!(o.block_voxels > 0.0) || !std::isfinite(o.block_voxels)) throw bad("block size must be positive");
+  if (o.smooth_passes < 0) throw bad("smooth passes must be non-negative");
+  if (o.multigrid_sweeps < 1 || o.coarsest_sweeps < 1 || o.krylov_cycle_sweeps < 1)
+    throw bad("multigrid sweeps must be at least 1");
+  if (!(o.tolerance_rms >= 0.0)) throw bad("RMS tolerance must be non-negative");
+  if (o.coarse_start_sweeps < 1) throw bad("coarse start sweeps must be at least 1");
+  if (!(o.multigrid_overcorrection > 0.0 && o.multigrid_overcorrection < 2.0))
+    throw bad("multigrid over-correction must lie in (0, 2)");
+  if (o.max_reach_agents == 0 || o.max_reach_agents > 255) throw bad("max reach agents must be 1 to 255");
+  if (o.feature_zone_rings < 0 || o.feature_zone_rings > 16) throw bad("feature zone must be 0 to 16 one-ring steps");
+  if (!(o.snap_regularisation > 0.0) || !std::isfinite(o.snap_regularisation))
+    throw bad("snap regularisation must be positive");
+}
+
+}  // namespace
+
+double surface_voxel(const Garment& g, const SurfaceOptions& options) {
+  if (options.voxel != 0.0) return options.voxel;
+  // More agents than vertices adds no detail the reconstruction could show; it only slows the solve.
+  return auto_voxel_size(g, std::min(options.agent_budget, std::max<std::size_t>(g.vertex_count(), 1000)));
+}
+
+std::vector<std::uint32_t> surface_layers(const Garment& g, const SurfaceOptions& options, double voxel) {
+  if (!options.layers) return {};
+  return garment_layers(g, options.layer_min_area * voxel * voxel, options.layer_join * voxel);
+}
+
+SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, const SurfaceOptions& options,
+                                    const SurfaceAttachment* feature_attachment) {
+  check_options(options);
+  check_finite(features, "feature sample");
+  SurfaceBinding s;
+  s.options_ = options;
+  s.vertex_count_ = g.vertex_count();
+  SurfaceStats& st = s.stats_;
+  Stopwatch clock;
+
+  // Everything here is bound on the ORIGINAL garment, not on the warped one as in
+  // the paper: agents, rings and encoding then serve every body B, and the
+  // encoding is the original local shape the step restores (DESIGN.md).
+  st.voxel_was_auto = options.voxel == 0.0;
+  s.h_ = surface_voxel(g, options);
+  st.voxel = s.h_;
+  const VoxelGrid grid = make_voxel_grid(g, features, s.h_);
+  const std::size_t nf = static_cast<std::size_t>(features.rows());
+  const std::size_t nv = g.vertex_count();
+  // Feature samples move with the garment where they sit (when they have no
+  // warped position) and belong to its layer there.
+  if (nf > 0 && nv > 0) {
+    if (feature_attachment && feature_attachment->vertex.size() != nf)
+      throw Error("surface: the feature attachment has " + std::to_string(feature_attachment->vertex.size()) +
+                  " samples, the features " + std::to_string(nf));
+    s.feature_attachment_ = feature_attachment ? *feature_attachment : attach_points(g, features);
+  }
+  const std::vector<std::uint32_t> vertex_layer = surface_layers(g, options, s.h_);
+  std::vector<std::uint32_t> feature_layer(nf, 0);
+  if (!vertex_layer.empty() && !s.feature_attachment_.vertex.empty())
+    for (std::size_t k = 0; k < nf; ++k) {
+      const auto& w = s.feature_attachment_.weight[k];
+      const int j = int(std::max_element(w.begin(), w.end()) - w.begin());
+      feature_layer[k] = vertex_layer[s.feature_attachment_.vertex[k][j]];
+    }
+  std::vector<std::uint64_t> feature_voxel(nf);
+  std::vector<VoxelLayer> skip(nf);
+  for (std::size_t k = 0; k < nf; ++k) {
+    feature_voxel[k] = VoxelGrid::morton(grid.cell(row3(features, Index(k))));
+    skip[k] = {feature_voxel[k], feature_layer[k]};
+  }
+  std::sort(skip.begin(), skip.end());
+  skip.erase(std::unique(skip.begin(), skip.end()), skip.end());
+  st.ms.sample = clock.ms();
+  clock.reset();
+
+  GarmentAgents ga = select_agents(g, grid, skip, vertex_layer);
+  const std::size_t ng = ga.size(), n = ng + nf;
+  st.samples = ga.samples;
+  st.garment_agents = ng;
+  st.feature_agents = nf;
+  st.agents = n;
+  Points natural(static_cast<Eigen::Index>(n), 3);
+  if (ng > 0) natural.topRows(static_cast<Eigen::Index>(ng)) = ga.positions(g.positions);
+  if (nf > 0) natural.bottomRows(static_cast<Eigen::Index>(nf)) = features;
+  std::vector<std::uint64_t> morton = ga.voxel;
+  morton.insert(morton.end(), feature_voxel.begin(), feature_voxel.end());
+  std::vector<std::uint32_t> natural_layer = ga.layer;
+  natural_layer.insert(natural_layer.end(), feature_layer.begin(), feature_layer.end());
+  st.layers = vertex_layer.empty() ? 0 : *std::max_element(vertex_layer.begin(), vertex_layer.end());
+  st.ms.agents = clock.ms();
+  clock.reset();
+
+  OrderedAgents ord =
+      order_agents(natural, morton, natural_layer, options.ring_radius_voxels * s.h_, options.block_voxels * s.h_);
+  const std::vector<Index>& order = ord.order;
+  const double width = ord.width;
+  s.ring_ = std::move(ord.ring);
+  s.original_agents_.resize(static_cast<Eigen::Index>(n), 3);
+  s.src_vertex_.resize(n);
+  s.src_weight_.resize(n);
+  s.feature_of_.assign(n, -1);
+  s.feature_slot_.resize(nf);
+  s.layer_.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const Index old = order[k];
+    s.original_agents_.row(static_cast<Eigen::Index>(k)) = natural.row(old);
+    s.layer_[k] = natural_layer[old];
+    if (old < ng) {
+      s.src_vertex_[k] = ga.vertex[old];
+      s.src_weight_[k] = ga.weight[old];
+    } else {
+      s.feature_of_[k] = static_cast<std::int32_t>(old - ng);
+      s.feature_slot_[old - ng] = Index(k);
+    }
+  }
+  order_rings(s.original_agents_, s.ring_, s.ring_open_);
+  s.schedule_ = make_schedule(s.original_agents_, s.ring_, width);
+  st.blocks = s.schedule_.blocks();
+  st.sequential_agents = s.schedule_.sequential_agents.size();
+  st.block_width = width;
+  for (std::size_t a = 0; a < n; ++a) st.ring_degree_max = std::max(st.ring_degree_max, s.ring_.row_size(a));
+  st.ring_degree_mean = n ? double(s.ring_.indices.size()) / double(n) : 0.0;
+  // Normal orientation, bound on the original: a frame flipped in both states
+  // re-emits the same point, so this only has to be consistent, not B-specific.
+  if (!options.fit_rotations) s.flip_ = orient_normals(fan_normals(s.original_agents_, s.ring_, s.ring_open_), s.ring_);
+  s.group_ = ring_groups(s.ring_);
+  // The features' zone: agents within feature_zone_rings one-ring steps (either
+  // direction) of a feature agent.
+  if (options.feature_zone_rings > 0) {
+    s.near_feature_.assign(n, 0);
+    for (std::size_t a = 0; a < n; ++a) s.near_feature_[a] = s.feature_of_[a] >= 0;
+    for (int k = 0; k < options.feature_zone_rings; ++k) {
+      std::vector<std::uint8_t> grown = s.near_feature_;
+      for (std::size_t a = 0; a < n; ++a)
+        for (Index q : s.ring_.row(a))
+          if (s.near_feature_[a] || s.near_feature_[q]) grown[a] = grown[q] = 1;
+      if (grown == s.near_feature_) break;  // the zone covers the features' groups
+      s.near_feature_ = std::move(grown);
+    }
+    st.feature_zone_agents = std::size_t(std::count(s.near_feature_.begin(), s.near_feature_.end(), 1));
+  }
+  s.groups_ = 0;
+  for (std::size_t a = 0; a < n; ++a) s.groups_ += s.group_[a] == a;
+  st.ms.one_ring = clock.ms();
+  clock.reset();
+
+  // Encoded on the original always (the rings are needed either way); with
+  // encode_on_warped apply encodes again on the warped agents.
+  s.rows_ = encode_agents(s.original_agents_, s.ring_);
+  st.degenerate_rows = s.rows_.degenerate;
+  st.ms.encode = clock.ms();
+  clock.reset();
+
+  s.levels_ = build_coarse_levels(s.original_agents_, s.layer_, s.feature_of_, s.h_, options.coarse_levels,
+                                  options.coarse_min_agents, options.ring_radius_voxels, options.block_voxels);
+  st.levels = 1 + int(s.levels_.size());
+  st.ms.encode += clock.ms();
+  clock.reset();
+
+  s.bind_vertex_blends(g.positions, vertex_layer);
+  if (options.feature_zone_rings > 0) {
+    s.carries_feature_.assign(nv, 0);
+    for (std::size_t k = 0; k < s.feature_attachment_.vertex.size(); ++k)
+      for (int j = 0; j < 3; ++j)
+        if (s.feature_attachment_.weight[k][j] != 0.0) s.carries_feature_[s.feature_attachment_.vertex[k][j]] = 1;
+  }
+  if (options.emit_from_original && !options.encode_on_warped) s.original_vertices_ = g.positions;
+  st.ms.reconstruct = clock.ms();  // bind share of the reconstruction (vertex lists)
+  return s;
+}
+
+}  // namespace refit

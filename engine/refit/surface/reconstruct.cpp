@@ -1,0 +1,202 @@
+// From agents back to vertices (paper eq. 4 and beyond): each vertex's agents
+// within reach and their blend weights (bound once), anchored agents following
+// their solved neighbours, the smoothing of the solved displacements, the
+// re-emission of every vertex from its agents' rotations, and eq. 14 for the
+// vertices that touch body B.
+#include <refit/body/centre_tree.hpp>
+#include <refit/core/parallel.hpp>
+#include <refit/surface/agents.hpp>
+#include <refit/surface/surface.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numeric>
+
+namespace refit {
+
+namespace {
+constexpr std::size_t kGrain = 1024;
+}  // namespace
+
+void SurfaceBinding::bind_vertex_blends(const Points& positions, const std::vector<std::uint32_t>& vertex_layer) {
+  const std::size_t n = agent_count(), nv = vertex_count_;
+  // Each vertex's nearest agents within reach (a bounded k-nearest query), and the
+  // nearest agent (for vertices with none).
+  const std::size_t kmax = options_.max_reach_agents;
+  nearest_.assign(nv, 0);
+  if (n > 0) {
+    // A vertex of a layer blends its own layer's agents only.
+    const LayerTrees tree(original_agents_, layer_);
+    const double reach2 = std::pow(options_.reach_voxels * h_, 2);
+    std::vector<std::uint8_t> capped(nv, 0);
+    std::vector<std::uint8_t> count(nv, 0);
+    UninitVector<Index> idx_all(nv * kmax);  // slots past a vertex's count stay unset and unread
+    UninitVector<float> w_all(options_.smooth_blend ? nv * kmax : 0);
+    parallel_for(0, nv, 2048, [&](std::size_t b, std::size_t e) {
+      std::vector<Index> idx;
+      std::vector<double> d2;
+      for (std::size_t v = b; v < e; ++v) {
+        const Vec3 p = row3(positions, Index(v));
+        tree.knn(vertex_layer.empty() ? 0u : vertex_layer[v], p, kmax + 1, idx, d2);
+        std::size_t m = 0;
+        while (m < idx.size() && m < kmax && d2[m] < reach2) ++m;
+        capped[v] = m == kmax && idx.size() > m && d2[m] < reach2;
+        nearest_[v] = idx.empty() ? 0 : idx.front();
+        count[v] = static_cast<std::uint8_t>(m);
+        std::copy(idx.begin(), idx.begin() + std::ptrdiff_t(m), idx_all.begin() + std::ptrdiff_t(v * kmax));
+        if (options_.smooth_blend && m > 0) {
+          // Beyond the paper: eq. 4's 1/|local|^3 interpolates each agent (flat
+          // spots at the agents, steep changes between them: the neighbours' small
+          // differences in motion show as ripples at the agent spacing). A smooth
+          // kernel (1 - d^2/R^2)^2 whose radius R is the distance to the first agent
+          // left out (or the reach) varies smoothly with the vertex, so the blend is
+          // smooth. Bound on the original: every body B blends alike.
+          const double r2 = m < idx.size() ? std::min(d2[m], reach2) : reach2;
+          double sum = 0.0;
+          std::array<double, 256> w{};
+          for (std::size_t j = 0; j < m; ++j) {
+            const double t = std::max(0.0, 1.0 - d2[j] / r2);
+            sum += w[j] = t * t;
+          }
+          if (!(sum > 1e-12)) {
+            w.fill(0.0);
+            w[0] = sum = 1.0;
+          }
+          for (std::size_t j = 0; j < m; ++j) w_all[v * kmax + j] = static_cast<float>(w[j] / sum);
+        }
+      }
+    });
+    reach_.offsets.assign(nv + 1, 0);
+    for (std::size_t v = 0; v < nv; ++v) reach_.offsets[v + 1] = reach_.offsets[v] + count[v];
+    reach_.indices.resize(reach_.offsets[nv]);
+    if (options_.smooth_blend) reach_weight_.resize(reach_.offsets[nv]);
+    parallel_for(0, nv, 8192, [&](std::size_t b, std::size_t e) {
+      for (std::size_t v = b; v < e; ++v)
+        for (std::size_t j = 0; j < count[v]; ++j) {
+          reach_.indices[reach_.offsets[v] + j] = idx_all[v * kmax + j];
+          if (options_.smooth_blend) reach_weight_[reach_.offsets[v] + j] = w_all[v * kmax + j];
+        }
+    });
+    stats_.vertices_capped = std::accumulate(capped.begin(), capped.end(), std::size_t{0});
+    for (std::size_t v = 0; v < nv; ++v) stats_.vertices_without_agent += count[v] == 0;
+  } else {
+    reach_.offsets.assign(nv + 1, 0);
+  }
+}
+
+// Beyond the paper: an anchored agent (its group has nothing fixed: a layer of
+// its own with no feature and nowhere near body B, such as a loose overskirt
+// over a fitted one) moves with the step's correction of the solved agents
+// within reach (inverse squared distance blend of the 4 nearest), so it keeps to
+// the layer beneath instead of staying where the warp put it; one with none
+// within reach stays as warped.
+std::size_t SurfaceBinding::follow_anchored(const Points& before, const std::vector<std::uint8_t>& fixed,
+                                            const std::vector<std::uint8_t>& fr, Points& x,
+                                            std::vector<std::uint8_t>& anchored_kept) const {
+  const std::size_t n = agent_count();
+  std::vector<std::uint8_t> solved(n, 0);
+  for (std::size_t a = 0; a < n; ++a) {
+    solved[a] = fixed[a] || fr[a];
+    anchored_kept[a] = !solved[a];
+  }
+  if (std::count(solved.begin(), solved.end(), 1) > 0) {
+    const PointTree tree(before, solved);
+    const double reach2 = std::pow(options_.reach_voxels * h_, 2);
+    const Points correction = x - before;
+    parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
+      std::vector<Index> idx;
+      std::vector<double> d2;
+      for (std::size_t a = b; a < e; ++a) {
+        if (solved[a]) continue;
+        tree.knn(row3(before, Index(a)), 4, idx, d2);
+        Vec3 c = Vec3::Zero();
+        double sum = 0.0;
+        for (std::size_t j = 0; j < idx.size() && d2[j] < reach2; ++j) {
+          const double w = 1.0 / (d2[j] + 1e-12 * reach2);
+          c += w * row3(correction, idx[j]);
+          sum += w;
+        }
+        if (sum == 0.0) continue;
+        x.row(Eigen::Index(a)) += (c / sum).transpose();
+        anchored_kept[a] = 0;
+      }
+    });
+  }
+  std::size_t followed = 0;
+  for (std::size_t a = 0; a < n; ++a) followed += !fixed[a] && !fr[a] && !anchored_kept[a];
+  return followed;
+}
+
+// Beyond the paper: the solution on irregular agents carries agent-scale noise
+// in its displacement (each h is exact only for its own original ring), which
+// the reconstruction shows as waviness. A few Jacobi passes move each free
+// agent's displacement (from the state its vertices are re-emitted from)
+// halfway to its ring's mean: fixed and anchored agents stay, A = B stays
+// exact (zero displacement), and the result is the same for any thread count.
+void SurfaceBinding::smooth_displacements(const Points& before, const std::vector<std::uint8_t>& fr, Points& x) const {
+  const std::size_t n = agent_count();
+  for (int pass = 0; pass < options_.smooth_passes; ++pass) {
+    const Points d = x - (options_.emit_from_original && !options_.encode_on_warped ? original_agents_ : before);
+    Points nx = x;
+    parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
+      for (std::size_t a = b; a < e; ++a) {
+        if (!fr[a] || ring_.row_size(a) == 0) continue;
+        Vec3 m = Vec3::Zero();
+        for (Index q : ring_.row(a)) m += row3(d, q);
+        m /= double(ring_.row_size(a));
+        nx.row(Eigen::Index(a)) += (0.5 * (m - row3(d, Index(a)))).transpose();
+      }
+    });
+    x = std::move(nx);
+  }
+}
+
+// emit_from_original (beyond the paper, which re-emits the warped vertices from
+// the warped agents' frames): each vertex keeps its original offsets to its
+// agents, turned by the agents' rotations from the original to the result.
+// The warp's own detail finer than the agent spacing (its creases where the
+// body's triangles change) is then replaced by the garment's original detail,
+// which is what this step restores; coarser warp changes live in the agents.
+// With encode_on_warped the target shape is the warp's, so its detail stays.
+// Anchored agents that had no solved agent within reach hand their vertices back as warped.
+Points SurfaceBinding::reconstruct(const Points& warped, const Points& before, const Points& x,
+                                   const std::vector<std::uint8_t>& anchored_kept, bool some_anchored_kept) const {
+  const bool orig = options_.emit_from_original && !options_.encode_on_warped;
+  const Points& from = orig ? original_agents_ : before;
+  std::vector<Eigen::Matrix3d> rot;
+  if (options_.fit_rotations) {
+    rot = ring_rotations(from, x, ring_);
+  } else {
+    rot = frame_rotations(agent_frames(from, ring_, ring_open_, flip_), agent_frames(x, ring_, ring_open_, flip_));
+  }
+  std::vector<std::uint8_t> keep;
+  if (orig && some_anchored_kept) keep = anchored_kept;
+  return reconstruct_rotations(orig ? original_vertices_ : warped, from, x, rot, reach_, reach_weight_, nearest_, keep,
+                               &warped);
+}
+
+// Eq. 14 for the vertices too: blending frames of nearby free agents must not
+// pull a vertex that touches the body. Only vertices the nearest agent's
+// distance cannot rule out are queried: d(v) >= d(a) - |v - a|.
+std::vector<std::uint8_t> SurfaceBinding::keep_near_vertices(const Points& warped, const Points& before,
+                                                             const std::vector<double>& body_distance,
+                                                             const std::function<double(const Vec3&)>& distance,
+                                                             Points& positions) const {
+  std::vector<std::uint8_t> kept(vertex_count_, 0);
+  parallel_for(0, vertex_count_, 1024, [&](std::size_t b, std::size_t e) {
+    for (std::size_t v = b; v < e; ++v) {
+      const Index a = nearest_[v];
+      if (!near_feature_.empty() && (near_feature_[a] || carries_feature_[v])) continue;
+      const Vec3 p = row3(warped, Index(v));
+      if (feature_of_[a] < 0 && body_distance[a] - (p - row3(before, a)).norm() >= options_.epsilon) continue;
+      if (distance(p) < options_.epsilon) {
+        positions.row(Eigen::Index(v)) = warped.row(Eigen::Index(v));
+        kept[v] = 1;
+      }
+    }
+  });
+  return kept;
+}
+
+}  // namespace refit
