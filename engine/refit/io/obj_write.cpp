@@ -1,0 +1,240 @@
+// Writing a garment OBJ: the source file's text with only the moved positions
+// (and the normals they change) rewritten, or a plain OBJ; atomically.
+#include <refit/io/obj_garment.hpp>
+
+#include <refit/core/error.hpp>
+#include <refit/core/parallel.hpp>
+#include <refit/io/atomic_file.hpp>
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <optional>
+#include <utility>
+
+
+namespace refit {
+namespace {
+
+void append_number(std::string& out, double x) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, x);
+  out.append(buf, r.ptr);
+}
+
+void append_index(std::string& out, std::size_t i) {
+  char buf[24];
+  const auto r = std::to_chars(buf, buf + sizeof buf, i);
+  out.append(buf, r.ptr);
+}
+
+void append_xyz(std::string& out, double x, double y, double z) {
+  append_number(out, x);
+  out.push_back(' ');
+  append_number(out, y);
+  out.push_back(' ');
+  append_number(out, z);
+}
+
+bool same_bits(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); }
+
+void check_finite(const Points& p, const std::string& where) {
+  const std::size_t n = static_cast<std::size_t>(p.rows());
+  constexpr std::size_t kGrain = 1 << 16;
+  const std::size_t blocks = (n + kGrain - 1) / kGrain;
+  std::vector<std::size_t> first_bad(blocks, n);
+  parallel_for(0, blocks, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k)
+      for (std::size_t i = k * kGrain; i < std::min(n, (k + 1) * kGrain); ++i) {
+        const auto ii = static_cast<Eigen::Index>(i);
+        if (!std::isfinite(p(ii, 0)) || !std::isfinite(p(ii, 1)) || !std::isfinite(p(ii, 2))) {
+          first_bad[k] = i;
+          break;
+        }
+      }
+  });
+  for (std::size_t i : first_bad)
+    if (i < n) throw input_error(where, "vertex " + std::to_string(i + 1) + " has a non-finite coordinate; nothing written");
+}
+
+// The output in parts (one per chunk of the source, or per block of elements),
+// each formatted on demand: a writer streams them without the whole file in memory.
+struct Parts {
+  std::size_t count = 0;
+  PartFormatter format;
+};
+
+std::string join(const Parts& parts) {
+  std::vector<std::string> text(parts.count);
+  parallel_for(0, parts.count, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) parts.format(k, text[k]);
+  });
+  std::size_t total = 0;
+  for (const auto& t : text) total += t.size();
+  std::string out;
+  out.reserve(total);
+  for (auto& t : text) {
+    out += t;
+    std::string().swap(t);
+  }
+  return out;
+}
+
+// A plain OBJ for garments that come from no file.
+Parts format_plain(const Garment& g, const Points& x) {
+  const std::size_t nv = g.vertex_count();
+  constexpr std::size_t kGrain = 1 << 15;
+  const auto blocks = [](std::size_t n) { return (n + kGrain - 1) / kGrain; };
+  const std::size_t bv = blocks(nv), bf = blocks(g.faces.rows()), bl = blocks(g.lines.rows()), bp = blocks(g.points.rows());
+  const auto csr_part = [](const Csr& csr, const char* kw, std::size_t k, std::string& out) {
+    for (std::size_t r = k * kGrain; r < std::min(csr.rows(), (k + 1) * kGrain); ++r) {
+      out += kw;
+      for (Index i : csr.row(r)) {
+        out.push_back(' ');
+        append_index(out, std::size_t(i) + 1);
+      }
+      out.push_back('\n');
+    }
+  };
+  return {bv + bf + bl + bp, [&g, &x, nv, bv, bf, bl, csr_part](std::size_t k, std::string& out) {
+            if (k < bv) {
+              for (std::size_t i = k * kGrain; i < std::min(nv, (k + 1) * kGrain); ++i) {
+                const auto ii = static_cast<Eigen::Index>(i);
+                out += "v ";
+                append_xyz(out, x(ii, 0), x(ii, 1), x(ii, 2));
+                out.push_back('\n');
+              }
+            } else if (k < bv + bf) {
+              csr_part(g.faces, "f", k - bv, out);
+            } else if (k < bv + bf + bl) {
+              csr_part(g.lines, "l", k - bv - bf, out);
+            } else {
+              csr_part(g.points, "p", k - bv - bf - bl, out);
+            }
+          }};
+}
+
+// Each referenced normal: the normalised sum of the area-weighted (Newell)
+// normals of the faces whose corners use it. Sequential scatter in face order,
+// so the sums are the same whatever the thread count.
+std::vector<std::uint8_t> recompute_normals(const Garment& g, const Points& x, const ObjSource& s, Points& normals,
+                                            ObjWriteReport& report) {
+  const std::size_t nn = static_cast<std::size_t>(s.normals.rows());
+  std::vector<std::uint8_t> recomputed(nn, 0);
+  normals = Points::Zero(static_cast<Eigen::Index>(nn), 3);
+  std::vector<std::uint8_t> used(nn, 0);
+  for (std::size_t f = 0; f < g.faces.rows(); ++f) {
+    const auto row = g.faces.row(f);
+    Vec3 n = Vec3::Zero();
+    for (std::size_t k = 0; k < row.size(); ++k) {
+      const Vec3 a = row3(x, row[k]);
+      const Vec3 b = row3(x, row[(k + 1) % row.size()]);
+      n += a.cross(b);
+    }
+    for (std::size_t k = g.faces.offsets[f]; k < g.faces.offsets[f + 1]; ++k) {
+      const Index ni = s.corner_normals[k];
+      if (ni == ObjSource::kNoNormal) continue;
+      normals.row(ni) += n.transpose();
+      used[ni] = 1;
+    }
+  }
+  std::size_t degenerate = 0;
+  for (std::size_t i = 0; i < nn; ++i) {
+    if (!used[i]) continue;
+    const double len = normals.row(static_cast<Eigen::Index>(i)).norm();
+    if (len > 0 && std::isfinite(len)) {
+      normals.row(static_cast<Eigen::Index>(i)) /= len;
+      recomputed[i] = 1;
+      ++report.normals_recomputed;
+    } else {
+      ++degenerate;
+    }
+  }
+  if (degenerate > 0)
+    report.warnings.push_back(std::to_string(degenerate) +
+                              " normals belong only to zero-area faces and were kept as they were");
+  return recomputed;
+}
+
+Parts format_source(const Garment& g, const Points& x, const ObjSource& s, ObjWriteReport& report,
+                    const std::string& where) {
+  if (g.vertex_count() != s.vertex_spans.size())
+    throw input_error(where, "the garment has " + std::to_string(g.vertex_count()) + " vertices but its source " +
+                                 s.file + " has " + std::to_string(s.vertex_spans.size()) +
+                                 "; it cannot be written back line for line");
+  if (g.faces.indices.size() != s.face_corner_count)
+    throw input_error(where, "the garment's faces differ from its source " + s.file +
+                                 "; it cannot be written back line for line");
+  const std::size_t nv = g.vertex_count();
+  // Unmoved vertices keep their original text, so an unchanged garment is
+  // written back byte for byte.
+  std::vector<std::uint8_t> moved(nv, 0);
+  const std::size_t moved_count = deterministic_sum<std::size_t>(0, nv, 1 << 15, 0, [&](std::size_t i) -> std::size_t {
+    const auto ii = static_cast<Eigen::Index>(i);
+    bool m = false;
+    for (int k = 0; k < 3; ++k) m |= !same_bits(x(ii, k), s.positions(ii, k));
+    moved[i] = m;
+    return m ? 1 : 0;
+  });
+  Points normals;
+  std::vector<std::uint8_t> recomputed;
+  if (moved_count > 0 && !s.corner_normals.empty()) recomputed = recompute_normals(g, x, s, normals, report);
+
+  // Shared by the copies of the formatter (std::function copies what it holds).
+  struct Edits {
+    std::vector<std::uint8_t> moved, recomputed;
+    Points normals;
+  };
+  auto edits = std::make_shared<Edits>(Edits{std::move(moved), std::move(recomputed), std::move(normals)});
+  return {s.chunk_begin.size() - 1, [&x, &s, edits](std::size_t c, std::string& out) {
+            std::size_t pos = s.chunk_begin[c];
+            const std::size_t end = s.chunk_begin[c + 1];
+            out.reserve(end - pos + (end - pos) / 4);
+            std::size_t vi = s.chunk_first_vertex[c], ni = s.chunk_first_normal[c];
+            const std::size_t vend = s.chunk_first_vertex[c + 1], nend = s.chunk_first_normal[c + 1];
+            while (vi < vend || ni < nend) {
+              const bool vertex = ni >= nend || (vi < vend && s.vertex_spans[vi].begin < s.normal_spans[ni].begin);
+              const std::size_t i = vertex ? vi++ : ni++;
+              if (vertex ? !edits->moved[i] : (edits->recomputed.empty() || !edits->recomputed[i])) continue;
+              const ObjSource::Span sp = vertex ? s.vertex_spans[i] : s.normal_spans[i];
+              const Points& p = vertex ? x : edits->normals;
+              const auto ii = static_cast<Eigen::Index>(i);
+              out.append(s.text.view().substr(pos, sp.begin - pos));
+              append_xyz(out, p(ii, 0), p(ii, 1), p(ii, 2));
+              pos = sp.end;
+            }
+            out.append(s.text.view().substr(pos, end - pos));
+          }};
+}
+
+Parts format_impl(const Garment& g, const Points& x, ObjWriteReport& report, const std::string& where) {
+  check_finite(x, where);
+  return g.source ? format_source(g, x, *g.source, report, where) : format_plain(g, x);
+}
+
+}  // namespace
+
+std::string format_garment_obj(const Garment& g, ObjWriteReport* report) {
+  ObjWriteReport local;
+  return join(format_impl(g, g.positions, report ? *report : local, g.source ? g.source->file : std::string("<garment>")));
+}
+
+ObjWriteReport write_garment_obj(const std::string& path, const Garment& g) {
+  return write_garment_obj(path, g, g.positions);
+}
+
+ObjWriteReport write_garment_obj(const std::string& path, const Garment& g, const Points& positions) {
+  if (positions.rows() != g.positions.rows())
+    throw input_error(path, "cannot write " + std::to_string(positions.rows()) + " positions for a garment of " +
+                                std::to_string(g.positions.rows()) + " vertices");
+  ObjWriteReport report;
+  const Parts parts = format_impl(g, positions, report, path);
+  write_parts_atomically(path, parts.count, parts.format);
+  return report;
+}
+
+}  // namespace refit
