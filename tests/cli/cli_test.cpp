@@ -103,7 +103,8 @@ TEST(Cli, PaperVariantsRunAndChangeTheResult) {
   const std::string ours = c.dir.file("ours.obj");
   ASSERT_EQ(run_cli(c.resize(ours, feats)).exit_code, 0);
   const Garment base = read_garment_obj(ours);
-  for (const char* flag : {"--paper-surface", "--paper-closeness", "--encode-on-warped", "--plain-sweeps", "--feature-zone 0"}) {
+  for (const char* flag : {"--method paper", "--paper-surface", "--paper-closeness", "--encode-on-warped", "--plain-sweeps",
+                           "--feature-zone 0"}) {
     std::string name = flag + 2;
     std::replace(name.begin(), name.end(), ' ', '_');
     const std::string out = c.dir.file(name + ".obj");
@@ -114,6 +115,24 @@ TEST(Cli, PaperVariantsRunAndChangeTheResult) {
     EXPECT_TRUE(g.positions.allFinite()) << flag;
     EXPECT_GT((g.positions - base.positions).cwiseAbs().maxCoeff(), 1e-3) << flag;
   }
+}
+
+TEST(Cli, MethodPaperIsEveryPaperSwitchAtOnce) {
+  // The profile is a name for the switches, not a code path of its own: the same
+  // bytes as all of them given one by one, and an explicit --symmetry still wins.
+  const Case c;
+  const std::string feats = "--features '" + c.features + "' ";
+  const std::string profile = c.dir.file("profile.obj"), switches = c.dir.file("switches.obj");
+  const std::string mirrored = c.dir.file("mirrored.obj");
+  ASSERT_EQ(run_cli(c.resize(profile, feats + "--method paper")).exit_code, 0);
+  ASSERT_EQ(run_cli(c.resize(switches, feats + "--paper-closeness --paper-surface --encode-on-warped --plain-sweeps "
+                                               "--symmetry none --no-collision")).exit_code, 0);
+  EXPECT_EQ(test::read_text(profile), test::read_text(switches));
+  ASSERT_EQ(run_cli(c.resize(mirrored, feats + "--method paper --symmetry x")).exit_code, 0);
+  EXPECT_NE(test::read_text(profile), test::read_text(mirrored));
+  const auto bad = run_cli(c.resize(c.dir.file("bad.obj"), "--method papr"));
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("--method"), std::string::npos) << bad.err;
 }
 
 TEST(Cli, SameBodyGivesTheSameGarment) {

@@ -17,7 +17,7 @@ namespace refit::cli {
 namespace {
 
 struct ResizeArgs {
-  std::string garment, from, out, out_dir, report, features, curves_out, units = "cm", stage = "full", symmetry = "auto";
+  std::string garment, from, out, out_dir, report, features, curves_out, units = "cm", stage = "full", symmetry, method = "refit";
   std::vector<std::string> to;
   std::size_t threads = 0, max_triangles = WarpOptions{}.max_triangles;
   bool quiet = false, metrics = false, paper_closeness = false, no_shape_control = false, no_collision = false, encode_on_warped = false,
@@ -54,16 +54,19 @@ int run(const ResizeArgs& a) {
   if (a.to.size() > 1 && a.out_dir.empty()) throw Error("several --to bodies need --out-dir DIR");
   if (a.out.empty() && a.out_dir.empty()) throw Error("give --out FILE or --out-dir DIR");
   if (!a.out.empty() && !a.out_dir.empty()) throw Error("give --out or --out-dir, not both");
+  // --method paper: every choice the paper makes, each also a switch of its own
+  // (docs/method.md); an explicit --symmetry still wins.
+  const bool paper = a.method == "paper";
   ResizeOptions options;
   options.units = a.units;
   options.stage = parse_stage(a.stage);
   options.warp.max_triangles = a.max_triangles;
   options.surface = a.surface;
-  options.shape_matching.sampling_invariant = !a.paper_closeness;
-  options.surface.encode_on_warped = a.encode_on_warped;
-  if (a.plain_sweeps) options.surface.multigrid = false;
+  options.shape_matching.sampling_invariant = !(a.paper_closeness || paper);
+  options.surface.encode_on_warped = a.encode_on_warped || paper;
+  if (a.plain_sweeps || paper) options.surface.multigrid = false;
   if (a.v_cycles) options.surface.krylov = false;
-  if (a.paper_surface) {
+  if (a.paper_surface || paper) {
     options.surface.fit_rotations = false;
     options.surface.smooth_blend = false;
     options.surface.emit_from_original = false;
@@ -72,8 +75,8 @@ int run(const ResizeArgs& a) {
     options.surface.feature_zone_rings = 0;  // no zone, no snap
     options.surface.layers = false;
   }
-  options.collision = !a.no_collision;
-  options.symmetry = parse_symmetry(a.symmetry);
+  options.collision = !(a.no_collision || paper);
+  options.symmetry = parse_symmetry(!a.symmetry.empty() ? a.symmetry : paper ? "none" : "auto");
   options.metrics = a.metrics;
   options.clearance_cm = a.clearance;
   if (!a.curves_out.empty() && a.features.empty()) throw Error("--curves-out needs --features");
@@ -144,6 +147,9 @@ int run(const ResizeArgs& a) {
   return 0;
 }
 
+// Switches that change the method or the solver: a help section of their own.
+constexpr const char* kAdvanced = "Advanced (method switches and solver internals; docs/method.md)";
+
 const Register reg("resize", "Resize a garment from body A to one or many bodies B", [](CLI::App& app) {
   auto a = std::make_shared<ResizeArgs>();
   app.add_option("--garment", a->garment, "Garment OBJ around body A")->required();
@@ -159,42 +165,60 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
   app.add_option("--threads", a->threads, "Worker threads (0 = all cores)")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
-  app.add_option("--max-triangles", a->max_triangles, "Cap on the warp's triangle set per vertex")->capture_default_str();
+  app.add_option("--max-triangles", a->max_triangles, "Cap on the warp's triangle set per vertex")->capture_default_str()
+      ->group(kAdvanced);
   app.add_option("--features", a->features, "Feature curves (JSON) whose shape must survive");
+  app.add_option("--method", a->method,
+                 "refit: Refit's choices; paper: the paper's (plain feature sums, encoding on the warp, fan frames, "
+                 "eq. 4 blend, no zone, layers, smoothing, symmetry or collision, Gauss-Seidel sweeps; docs/method.md)")
+      ->check(CLI::IsMember({"refit", "paper"}))
+      ->capture_default_str();
   app.add_option("--curves-out", a->curves_out, "Write original, warped and optimised feature curves (OBJ l lines)");
   app.add_flag("--paper-closeness", a->paper_closeness,
-               "Feature closeness term as the paper's plain sums (weak: keeps most of the warp's bend)");
+               "Feature closeness term as the paper's plain sums (weak: keeps most of the warp's bend)")
+      ->group(kAdvanced);
   app.add_flag("--no-shape-control", a->no_shape_control, "The warp alone (same as --stage warp)");
   app.add_option("--voxel", a->surface.voxel, "Agent voxel size in cm (0 = from the garment size and --agents)")
-      ->capture_default_str();
-  app.add_option("--agents", a->surface.agent_budget, "Agent budget for the automatic voxel size")->capture_default_str();
+      ->capture_default_str()
+      ->group(kAdvanced);
+  app.add_option("--agents", a->surface.agent_budget, "Agent budget for the automatic voxel size")->capture_default_str()
+      ->group(kAdvanced);
   app.add_option("--epsilon", a->surface.epsilon, "Agents closer than this to body B (cm) keep their warped position")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->group(kAdvanced);
   app.add_option("--feature-zone", a->surface.feature_zone_rings,
                  "Within this many one-ring steps of a feature, the feature wins over --epsilon and the garment is "
                  "snapped through it (0 = the paper: --epsilon everywhere but on the features)")
       ->capture_default_str()
-      ->check(CLI::Range(0, 16));
+      ->check(CLI::Range(0, 16))
+      ->group(kAdvanced);
   app.add_flag("--no-layers", [a](std::int64_t) { a->surface.layers = false; },
                "One agent per voxel for the whole garment, as the paper (by default each layer of a multi-layer "
-               "garment gets its own agents, rings and blends)");
-  app.add_option("--max-iterations", a->surface.max_iterations, "Gauss-Seidel iterations, at most")->capture_default_str();
-  app.add_option("--tolerance", a->surface.tolerance, "Gauss-Seidel stops below this update norm")->capture_default_str();
+               "garment gets its own agents, rings and blends)")
+      ->group(kAdvanced);
+  app.add_option("--max-iterations", a->surface.max_iterations, "Gauss-Seidel iterations, at most")->capture_default_str()
+      ->group(kAdvanced);
+  app.add_option("--tolerance", a->surface.tolerance, "Gauss-Seidel stops below this update norm")->capture_default_str()
+      ->group(kAdvanced);
   app.add_option("--tolerance-rms", a->surface.tolerance_rms,
                  "If positive: stop when the update's RMS per free agent is below this (instead of --tolerance on its L2 norm)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->group(kAdvanced);
   app.add_flag("--plain-sweeps", a->plain_sweeps,
-               "The paper's plain Gauss-Seidel sweeps instead of multigrid cycles (same solution when both converge)");
+               "The paper's plain Gauss-Seidel sweeps instead of multigrid cycles (same solution when both converge)")
+      ->group(kAdvanced);
   app.add_flag("--v-cycles", a->v_cycles,
-               "Bare multigrid V-cycles instead of BiCGSTAB preconditioned by them (same solution when both converge)");
-  app.add_flag("--encode-on-warped", a->encode_on_warped, "Encode the local shape on the warped garment, not the original");
+               "Bare multigrid V-cycles instead of BiCGSTAB preconditioned by them (same solution when both converge)")
+      ->group(kAdvanced);
+  app.add_flag("--encode-on-warped", a->encode_on_warped, "Encode the local shape on the warped garment, not the original")
+      ->group(kAdvanced);
   app.add_flag("--paper-surface", a->paper_surface,
                "Surface step as the paper: fan-normal frames, eq. 4 blend of the warped vertices, no smoothing, no layers, "
-               "--feature-zone 0");
+               "--feature-zone 0")
+      ->group(kAdvanced);
   app.add_option("--symmetry", a->symmetry,
                  "auto: mirror each one-sided feature about x = c when garment and body A are mirror-symmetric; "
-                 "x: always; none: never (docs/features.md)")
-      ->capture_default_str();
+                 "x: always; none: never (default: auto; none with --method paper; docs/features.md)");
   app.add_flag("--no-collision", a->no_collision, "Do not push vertices inside body B out");
   app.add_option("--clearance", a->clearance, "Collision clearance outside body B in cm (0 to 10)")
       ->check(check_clearance)
