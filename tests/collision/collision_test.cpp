@@ -154,14 +154,54 @@ TEST(Collision, TheBodyPokingThroughACoarseFaceIsPushedOutToo) {
   ASSERT_EQ(count_face_centres_inside(g, out, body), 1u);
   const CollisionReport r = resolve_penetrations(g, out, body, o);
   EXPECT_EQ(r.too_close, 0u);  // no vertex of its own
-  EXPECT_EQ(r.face_centres_inside_before, 1u);
-  EXPECT_EQ(r.face_centres_inside_after, 0u);
+  EXPECT_EQ(r.faces_inside_before, 1u);
+  EXPECT_EQ(r.faces_inside_after, 0u);
   EXPECT_EQ(count_face_centres_inside(g, out, body), 0u);
-  // The middle face's centre clears the body by the clearance now.
+  // The middle face's centre clears the body by the face clearance now.
   Vec3 centre = Vec3::Zero();
   for (Index v : g.faces.row(12)) centre += row3(out, v);
-  EXPECT_GE(body.closest(centre / 4.0).distance, o.clearance * 0.99);
+  EXPECT_GE(body.closest(centre / 4.0).distance, o.face_clearance * 0.99);
   EXPECT_GT(r.moved, 4u);
+}
+
+TEST(Collision, TheBodyPokingThroughAFaceAwayFromItsCentreIsPushedOutToo) {
+  // The same grid at y = 9.92 shifted by 1 cm: the sphere's top (0, 10, 0) now
+  // pokes 0.08 through the face [-1, 3] x [-1, 3] near its corner (-1, -1),
+  // while its corners and its centre (1, 1) all clear the body.
+  const BodySurface body(sphere_body(4, 10.0));
+  Garment g;
+  g.positions.resize(36, 3);
+  for (int i = 0; i < 6; ++i)
+    for (int k = 0; k < 6; ++k) g.positions.row(i * 6 + k) << -9.0 + 4.0 * i, 9.92, -9.0 + 4.0 * k;
+  for (int i = 0; i < 5; ++i)
+    for (int k = 0; k < 5; ++k) {
+      const Index a = Index(i * 6 + k);
+      g.faces.push_row(std::array<Index, 4>{a, a + 1, a + 7, a + 6});
+    }
+  // Dense points of every face (bilinear), inside the body or not.
+  auto points_inside = [&](const Points& x) {
+    std::size_t inside = 0;
+    for (std::size_t f = 0; f < g.faces.rows(); ++f) {
+      const auto c = g.faces.row(f);
+      for (int i = 0; i <= 20; ++i)
+        for (int k = 0; k <= 20; ++k) {
+          const double u = i / 20.0, v = k / 20.0;
+          const Vec3 p = (1 - u) * (1 - v) * row3(x, c[0]) + u * (1 - v) * row3(x, c[1]) + u * v * row3(x, c[2]) +
+                         (1 - u) * v * row3(x, c[3]);
+          inside += body.inside(p);
+        }
+    }
+    return inside;
+  };
+  Points out = g.positions;
+  ASSERT_EQ(measure_penetration(out, body).inside, 0u);
+  ASSERT_EQ(count_face_centres_inside(g, out, body), 0u);
+  ASSERT_GT(points_inside(out), 0u);
+  const CollisionReport r = resolve_penetrations(g, out, body);
+  EXPECT_EQ(r.faces_inside_before, 1u);
+  EXPECT_EQ(r.faces_inside_after, 0u);
+  EXPECT_EQ(points_inside(out), 0u);
+  EXPECT_EQ(measure_sanity(g, out).flipped_faces, 0u);
 }
 
 TEST(Collision, SphereShellPartlyInsideComesOutBitIdenticalForAnyThreadCount) {

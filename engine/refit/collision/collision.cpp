@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace refit {
 
@@ -48,10 +49,127 @@ Vec3 face_centre(const Garment& g, const Points& positions, std::size_t f) {
   return centre / double(g.faces.row_size(f));
 }
 
-bool face_centre_inside(const Garment& g, const Points& positions, std::size_t f, const BodySurface& body) {
-  if (g.faces.row_size(f) < 3) return false;
+// Points of a fan triangle's interior the body may poke through while the
+// corners clear it: the centroid, the edge midpoints and a point near each
+// corner (barycentric weights).
+constexpr double kFaceSamples[7][3] = {{1.0 / 3, 1.0 / 3, 1.0 / 3}, {0.5, 0.5, 0.0}, {0.0, 0.5, 0.5}, {0.5, 0.0, 0.5},
+                                       {0.7, 0.15, 0.15},          {0.15, 0.7, 0.15}, {0.15, 0.15, 0.7}};
+
+// What each corner of face f needs so that no point of the face is inside or
+// closer than the clearance. A sample w0 a + w1 b + w2 c short by `amount`
+// along `dir` asks of each corner its least-squares share, amount w_i / sum w^2
+// along dir (moving the corners so moves the sample by exactly amount; the
+// centre asks the same of all corners, a point near a corner mostly of that
+// corner); a corner keeps the largest. Samples are only tested when the centre
+// lies within reach: every point of the face is within `radius` (its farthest
+// corner) of the centre, so a centre farther than radius + clearance from the
+// body clears the whole face. Returns whether a point of the face is inside.
+bool face_needs(const Garment& g, const Points& positions, std::size_t f, const BodySurface& body, double clearance,
+                std::vector<Constraint>& need) {
+  const auto face = g.faces.row(f);
+  need.assign(face.size(), Constraint{});
+  bool inside = false;
+  auto ask = [&](std::size_t corner, const Constraint& c, double share) {
+    if (share > 0.0 && c.amount * share > need[corner].amount) need[corner] = {c.dir, c.amount * share, true, c.inside};
+  };
   const Vec3 centre = face_centre(g, positions, f);
-  return centre.allFinite() && body.inside(centre);
+  double radius = 0.0;
+  for (Index v : face) radius = std::max(radius, (row3(positions, v) - centre).norm());
+  const Constraint at_centre = check_vertex(centre, body, clearance);
+  if (at_centre.active) {
+    inside = at_centre.inside;
+    for (std::size_t i = 0; i < face.size(); ++i) ask(i, at_centre, 1.0);
+  } else if (!(body.closest_within(centre, radius + clearance).distance < radius + clearance)) {
+    return false;
+  }
+  const Vec3 a = row3(positions, face[0]);
+  for (std::size_t k = 1; k + 1 < face.size(); ++k) {
+    const Vec3 b = row3(positions, face[k]), c = row3(positions, face[k + 1]);
+    for (const auto& w : kFaceSamples) {
+      const Constraint s = check_vertex(w[0] * a + w[1] * b + w[2] * c, body, clearance);
+      if (!s.active) continue;
+      inside = inside || s.inside;
+      const double norm2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+      ask(0, s, w[0] / norm2);
+      ask(k, s, w[1] / norm2);
+      ask(k + 1, s, w[2] / norm2);
+    }
+  }
+  return inside;
+}
+
+// Newell normal of face f with its region corners displaced by disp.
+template <class SlotOf>
+Vec3 face_normal(const Garment& g, const Points& positions, std::size_t f, const SlotOf& slot_of,
+                 const std::vector<Vec3>* disp) {
+  const auto face = g.faces.row(f);
+  Vec3 n = Vec3::Zero();
+  auto at = [&](Index v) {
+    Vec3 p = row3(positions, v);
+    if (disp) {
+      const long k = slot_of(v);
+      if (k >= 0) p += (*disp)[std::size_t(k)];
+    }
+    return p;
+  };
+  for (std::size_t i = 0; i < face.size(); ++i) n += at(face[i]).cross(at(face[(i + 1) % face.size()]));
+  return n;
+}
+
+// No folds: a face the correction would turn over (its normal against the one
+// it had) gets each corner's displacement replaced by the mean over its
+// turned-over faces of their corners' mean displacement (a face whose corners
+// all move alike keeps its normal), for up to `passes` passes. Faces the
+// correction does not reach (no region corner) cannot turn.
+template <class SlotOf>
+void unfold(const Garment& g, const Points& positions, const std::vector<Index>& region, const SlotOf& slot_of,
+            int passes, std::vector<Vec3>& disp) {
+  std::vector<Index> faces;  // faces with a corner in the region, ascending
+  for (std::size_t f = 0; f < g.faces.rows(); ++f) {
+    const auto face = g.faces.row(f);
+    if (face.size() >= 3 && std::any_of(face.begin(), face.end(), [&](Index v) { return slot_of(v) >= 0; }))
+      faces.push_back(Index(f));
+  }
+  std::vector<Vec3> before(faces.size());
+  parallel_for(0, faces.size(), 256, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) before[i] = face_normal(g, positions, faces[i], slot_of, nullptr);
+  });
+  std::vector<std::uint8_t> turned(faces.size());
+  for (int pass = 0; pass < passes; ++pass) {
+    parallel_for(0, faces.size(), 256, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i)
+        turned[i] = before[i].squaredNorm() > 0.0 && face_normal(g, positions, faces[i], slot_of, &disp).dot(before[i]) <= 0.0;
+    });
+    std::vector<Vec3> sum(region.size(), Vec3::Zero());
+    std::vector<int> count(region.size(), 0);
+    bool any = false;
+    for (std::size_t i = 0; i < faces.size(); ++i) {
+      if (!turned[i]) continue;
+      any = true;
+      const auto face = g.faces.row(faces[i]);
+      Vec3 mean = Vec3::Zero();
+      for (Index v : face) {
+        const long k = slot_of(v);
+        if (k >= 0) mean += disp[std::size_t(k)];
+      }
+      mean /= double(face.size());
+      for (Index v : face) {
+        const long k = slot_of(v);
+        if (k < 0) continue;
+        sum[std::size_t(k)] += mean;
+        ++count[std::size_t(k)];
+      }
+    }
+    if (!any) return;
+    for (std::size_t k = 0; k < region.size(); ++k)
+      if (count[k] > 0) disp[k] = sum[k] / double(count[k]);
+  }
+}
+
+bool face_inside(const Garment& g, const Points& positions, std::size_t f, const BodySurface& body) {
+  if (g.faces.row_size(f) < 3) return false;
+  std::vector<Constraint> need;
+  return face_needs(g, positions, f, body, 0.0, need);
 }
 
 }  // namespace
@@ -76,6 +194,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   std::vector<std::uint8_t> is_touched(n, 0);
   std::vector<std::uint8_t> face_inside_before;  // per face: its centre inside body B before
   std::vector<Vec3> first_position;  // aligned with `touched`: where each started
+  std::vector<Index> touched_slot(n, 0);  // a touched vertex's slot in `touched`
 
   // The inside test's grid, built in parallel here rather than on the first
   // inside() call of the parallel loop below (there it would run on one thread).
@@ -109,6 +228,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     std::vector<std::vector<std::pair<Index, Constraint>>> face_found((nf + kBlock - 1) / kBlock);
     std::vector<std::size_t> faces_in(face_found.size(), 0);
     parallel_for(0, face_found.size(), 1, [&](std::size_t b, std::size_t e) {
+      std::vector<Constraint> need;
       for (std::size_t blk = b; blk < e; ++blk)
         for (std::size_t f = blk * kBlock; f < std::min(nf, (blk + 1) * kBlock); ++f) {
           const auto face = g.faces.row(f);
@@ -119,11 +239,11 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
             ok = ok && finite[v];
           }
           if (!check || !ok) continue;
-          const Constraint c = check_vertex(face_centre(g, positions, f), body_b, options.clearance);
-          if (!c.active) continue;
-          faces_in[blk] += c.inside;
-          if (round == 0) face_inside_before[f] = c.inside;
-          for (Index v : face) face_found[blk].emplace_back(v, c);
+          const bool in = face_needs(g, positions, f, body_b, options.face_clearance, need);
+          faces_in[blk] += in;
+          if (round == 0) face_inside_before[f] = in;
+          for (std::size_t i = 0; i < face.size(); ++i)
+            if (need[i].active) face_found[blk].emplace_back(face[i], need[i]);
         }
     });
     std::vector<std::pair<Index, Constraint>> by_vertex;
@@ -146,7 +266,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
       report.too_close = vertex_constraints;
       for (const auto& list : found)
         for (const auto& ic : list) report.inside_before += ic.second.inside ? 1 : 0;
-      for (std::size_t k : faces_in) report.face_centres_inside_before += k;
+      for (std::size_t k : faces_in) report.faces_inside_before += k;
     }
     if (active.empty()) break;
     report.rounds = round + 1;
@@ -168,6 +288,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     for (Index i : region)
       if (!is_touched[i]) {
         is_touched[i] = 1;
+        touched_slot[i] = Index(touched.size());
         touched.push_back(i);
         first_position.push_back(row3(positions, i));
       }
@@ -195,7 +316,38 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     std::vector<const Constraint*> con_at(m, nullptr);
     for (std::size_t k = 0, a = 0; k < m && a < active.size(); ++k)
       if (region[k] == active[a]) con_at[k] = &con[a++];
+    // Eq. 14's promise kept here too: a vertex near body B (within near_band)
+    // moves away from it by at most what it needs plus max_lift, so the spread
+    // of a deeper neighbour's push does not lift what sat on the body (measured
+    // on the real dress: vertices on body A ended 0.75 cm off body B). Farther
+    // vertices take the spread freely: it keeps the correction smooth.
+    std::vector<Vec3> cap_dir(m, Vec3::Zero());
+    std::vector<double> cap(m, std::numeric_limits<double>::infinity());
+    std::vector<double> sink_floor(m, -std::numeric_limits<double>::infinity());  // nor sink into the clearance
+    if (options.near_band > 0.0)
+      parallel_for(0, m, 256, [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) {
+          const Vec3 p = row3(positions, region[k]);
+          const ClosestPoint cp = body_b.closest_within(p, options.near_band);
+          if (!(cp.distance < options.near_band)) continue;
+          const Vec3 away = p - cp.point;
+          const double len = away.norm();
+          if (con_at[k]) {
+            cap_dir[k] = con_at[k]->dir;
+            cap[k] = con_at[k]->amount + options.max_lift;
+          } else if (len > 1e-12 * (1.0 + p.norm())) {
+            // The lift is a budget for the whole step, not per round.
+            cap_dir[k] = away / len;
+            const double lifted = (p - first_position[touched_slot[region[k]]]).dot(cap_dir[k]);
+            cap[k] = std::max(0.0, options.max_lift - lifted);
+            sink_floor[k] = std::min(0.0, options.clearance - len);
+          }
+        }
+      });
     auto enforce = [&](std::size_t k, Vec3& d) {
+      const double lift = d.dot(cap_dir[k]);
+      if (lift > cap[k]) d -= (lift - cap[k]) * cap_dir[k];
+      if (lift < sink_floor[k]) d += (sink_floor[k] - lift) * cap_dir[k];
       const Constraint* c = con_at[k];
       if (!c) return;
       const double along = d.dot(c->dir);
@@ -215,6 +367,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
       });
       std::swap(disp, next);
     }
+    unfold(g, positions, region, slot_of, options.unfold_passes, disp);
     parallel_for(0, m, 1024, [&](std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e; ++k) positions.row(region[k]) += disp[k].transpose();
     });
@@ -230,10 +383,10 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     });
   }
   // Only faces with a moved corner can have changed.
-  report.face_centres_inside_after = deterministic_sum<std::size_t>(0, g.faces.rows(), kGrain, 0, [&](std::size_t f) {
+  report.faces_inside_after = deterministic_sum<std::size_t>(0, g.faces.rows(), kGrain, 0, [&](std::size_t f) {
     const auto face = g.faces.row(f);
     const bool moved = std::any_of(face.begin(), face.end(), [&](Index v) { return is_touched[v] != 0; });
-    return std::size_t{moved ? face_centre_inside(g, positions, f, body_b) : face_inside_before[f] != 0};
+    return std::size_t{moved ? face_inside(g, positions, f, body_b) : face_inside_before[f] != 0};
   });
   double total = 0.0;
   for (std::size_t k = 0; k < touched.size(); ++k) {
@@ -256,8 +409,8 @@ nlohmann::json CollisionReport::to_json() const {
           {"max_displacement", max_displacement},
           {"mean_displacement", mean_displacement},
           {"inside_after", inside_after},
-          {"face_centres_inside_before", face_centres_inside_before},
-          {"face_centres_inside_after", face_centres_inside_after},
+          {"faces_inside_before", faces_inside_before},
+          {"faces_inside_after", faces_inside_after},
           {"rounds", rounds}};
 }
 

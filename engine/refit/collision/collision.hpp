@@ -1,8 +1,9 @@
 #pragma once
 // Penetration resolution (beyond the paper; runs after the surface step): garment
 // vertices inside body B or closer than a clearance, and the corners of faces
-// whose centre is, move out along the body's closest-point normal, and the
-// correction is spread smoothly over their neighbours so no spikes appear.
+// with an interior point that is, move out along the body's closest-point
+// normal, and the correction is spread smoothly over their neighbours so no
+// spikes appear; vertices near the body are lifted by at most what they need.
 #include <refit/body/body_surface.hpp>
 #include <refit/core/garment.hpp>
 
@@ -15,6 +16,10 @@ struct CollisionOptions {
   int smoothing_rings = 6;      // how far (in edges) a correction spreads
   int smoothing_passes = 12;    // Jacobi passes of the displacement field
   int max_rounds = 3;           // re-check and repeat while something is still too close
+  double near_band = 1.0;       // garment units: vertices this close to body B (before the step) are lifted off it
+  double max_lift = 0.1;        // by at most this beyond what they need (0 band: no limit)
+  double face_clearance = 0.05; // garment units: what points inside faces keep from body B
+  int unfold_passes = 20;       // passes that undo a correction turning a face over (see collision.cpp)
 };
 
 struct CollisionReport {
@@ -25,8 +30,8 @@ struct CollisionReport {
   double max_displacement = 0.0;
   double mean_displacement = 0.0;  // over the moved vertices
   std::size_t inside_after = 0;
-  std::size_t face_centres_inside_before = 0;  // faces whose centre is inside the body (the body poking through)
-  std::size_t face_centres_inside_after = 0;
+  std::size_t faces_inside_before = 0;  // faces with an interior point inside the body (the body poking through)
+  std::size_t faces_inside_after = 0;
   int rounds = 0;
 
   nlohmann::json to_json() const;

@@ -265,7 +265,11 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
     clock.reset();
     progress.stage("resolving penetrations");
     CollisionOptions co;
-    co.clearance = options_.clearance_cm * units_per_cm(options_.units);
+    const double per_cm = units_per_cm(options_.units);
+    co.clearance = options_.clearance_cm * per_cm;
+    co.near_band *= per_cm;  // the defaults are in cm
+    co.max_lift *= per_cm;
+    co.face_clearance *= per_cm;
     const CollisionReport c = resolve_penetrations(*garment_, result.positions, surface_b, co);
     timings["collision"] = clock.ms();
     report["collision"] = c.to_json();
