@@ -169,7 +169,8 @@ def score(case, original, faces, ids, body_a, body_b, dist_a, result, warp, curv
         hem = curves["hem"].on(result)
         s["hem_spread"] = float(hem[:, 1].max() - hem[:, 1].min())
     if report and "surface" in report:
-        s["feature_gap"] = report["surface"].get("feature_gap")
+        # On the written garment (after the collision step) where the report has it.
+        s["feature_gap"] = report["surface"].get("feature_gap_written", report["surface"].get("feature_gap"))
     return s
 
 

@@ -72,6 +72,31 @@ TEST(Cli, ResizeWritesOutputAndReport) {
     EXPECT_TRUE(j["surface"].contains(key)) << key;
 }
 
+TEST(Cli, TheReportSpeaksOfTheWrittenGarment) {
+  // The feature figures of the report are those of the file written (after the
+  // collision step), so `refit compare` on that file gives the same numbers.
+  const Case c;
+  const std::string out = c.dir.file("out.obj"), rep = c.dir.file("r.json"), scored = c.dir.file("c.json");
+  ASSERT_EQ(run_cli(c.resize(out, "--features '" + c.features + "' --report '" + rep + "'")).exit_code, 0);
+  const auto cmp = run_cli("compare --garment '" + c.garment + "' --from '" + c.a + "' --to '" + c.b + "' --result '" + out +
+                           "' --features '" + c.features + "' --report '" + scored + "'");
+  ASSERT_EQ(cmp.exit_code, 0) << cmp.err;
+  const auto j = nlohmann::json::parse(test::read_text(rep));
+  const auto k = nlohmann::json::parse(test::read_text(scored));
+  ASSERT_TRUE(j["surface"].contains("feature_gap_written"));
+  std::size_t matched = 0;
+  for (const auto& f : j["features"])
+    for (const auto& g : k["features"])
+      if (g["name"] == f["name"]) {
+        ++matched;
+        const double written = f["shape_error_output"], compared = g["result"]["shape_error"];
+        EXPECT_NEAR(written, compared, 1e-9 * (1.0 + compared)) << f["name"];
+        EXPECT_TRUE(f.contains("shape_error_output_before_collision")) << f["name"];
+        EXPECT_LE(double(f["gap_output"]), double(j["surface"]["feature_gap_written"])) << f["name"];
+      }
+  EXPECT_EQ(matched, k["features"].size());
+}
+
 TEST(Cli, LayersAreReportedAndNoLayersGivesThePapersSampling) {
   const Case c(8000, true);  // the dress over a slip
   const std::string feats = "--features '" + c.features + "' ";

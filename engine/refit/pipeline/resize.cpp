@@ -64,6 +64,31 @@ nlohmann::json surface_report(const SurfaceStats& s) {
             {"reconstruct", s.ms.reconstruct}}}};
 }
 
+// Every feature figure of the report measured on the written garment (after
+// the collision step, issue 13), the surface step's own beside it.
+void report_written_features(const SurfaceAttachment& attachment, const FeatureResult& curves,
+                             const ResizeResult& result, const Points& before_collision, nlohmann::json& report) {
+  auto& list = report["features"];
+  const Points on_result = carry(attachment, result.positions);
+  const Points on_warp = carry(attachment, result.warped);
+  Eigen::Index first = 0;
+  double gap = 0.0;
+  for (std::size_t i = 0; i < curves.curves.size(); ++i) {
+    const CurveResult& c = curves.curves[i];
+    const Eigen::Index m = c.original.rows();
+    list[i]["shape_error_output"] = shape_error(on_result.middleRows(first, m), c.original, c.closed);
+    list[i]["shape_error_output_before_collision"] = shape_error(before_collision.middleRows(first, m), c.original, c.closed);
+    // The same measure on the warped garment: on a coarse mesh, carrying samples
+    // on its faces adds faceting that the free-point warp of the samples has not.
+    list[i]["shape_error_output_warped"] = shape_error(on_warp.middleRows(first, m), c.original, c.closed);
+    const double curve_gap = (on_result.middleRows(first, m) - c.optimised).rowwise().norm().maxCoeff();
+    list[i]["gap_output"] = curve_gap;
+    gap = std::max(gap, curve_gap);
+    first += m;
+  }
+  report["surface"]["feature_gap_written"] = gap;
+}
+
 }  // namespace
 
 nlohmann::json garment_summary(const Garment& g) {
@@ -216,6 +241,7 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
   }
 
   // Step 3: the surface follows the curves and keeps its local shape (section 5).
+  Points feature_before_collision;
   if (surface_) {
     clock.reset();
     progress.stage("optimising the surface (" + std::to_string(surface_->agent_count()) + " agents)");
@@ -243,20 +269,8 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
       result.warnings.push_back("surface solve stopped after " + std::to_string(s.stats.iterations) +
                                 " iterations with update " + std::to_string(s.stats.final_update));
 
-    // How the written surface carries each feature (not just the optimised curve).
-    auto& list = report["features"];
-    const Points on_result = carry(feature_attachment_, result.positions);
-    const Points on_warp = carry(feature_attachment_, result.warped);
-    Eigen::Index first = 0;
-    for (std::size_t i = 0; i < curves.curves.size(); ++i) {
-      const CurveResult& c = curves.curves[i];
-      const Eigen::Index m = c.original.rows();
-      list[i]["shape_error_output"] = shape_error(on_result.middleRows(first, m), c.original, c.closed);
-      // The same measure on the warped garment: on a coarse mesh, carrying samples
-      // on its faces adds faceting that the free-point warp of the samples has not.
-      list[i]["shape_error_output_warped"] = shape_error(on_warp.middleRows(first, m), c.original, c.closed);
-      first += m;
-    }
+    // Where the surface step leaves each feature, before the collision step moves it.
+    feature_before_collision = carry(feature_attachment_, result.positions);
   }
   if (!result.positions.allFinite()) throw Error("internal: the surface step produced a non-finite position");
 
@@ -276,6 +290,8 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
     if (c.inside_after > 0)
       result.warnings.push_back(std::to_string(c.inside_after) + " vertices are still inside body B after collision resolution");
   }
+  if (surface_ && !curves.curves.empty())
+    report_written_features(feature_attachment_, curves, result, feature_before_collision, report);
   if (options_.metrics) {
     clock.reset();
     progress.stage("measuring");
