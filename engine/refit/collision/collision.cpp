@@ -186,6 +186,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   std::vector<Index> to_check;  // empty in round 1: check everything
   std::vector<Index> touched;   // every vertex any round may have moved
   std::vector<int> ring(n, -1);
+  std::vector<std::uint8_t> constrained(n, 0);  // this round's vertex constraints
   std::vector<std::uint8_t> finite(n, 0);
   parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) finite[i] = positions.row(static_cast<Eigen::Index>(i)).allFinite() ? 1 : 0;
@@ -221,6 +222,11 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     // inside body B, none of its corners). A face whose centre is inside or too
     // close gives each corner its centre's constraint (moving all corners by it
     // moves the centre by it); a corner with several keeps the largest.
+    // A face with a constrained corner waits for the next round: that corner's own
+    // move usually clears it, and asking its other corners now as well lifted
+    // vertices that sat on the body (the real jeans: 0.13 cm off body A, 0.81 off B).
+    for (const auto& list : found)
+      for (const auto& ic : list) constrained[ic.first] = 1;
     std::vector<std::uint8_t> check_face_of(round == 0 ? 0 : n, 0);
     if (round == 0) face_inside_before.assign(g.faces.rows(), 0);
     for (std::size_t k = 0; round > 0 && k < count; ++k) check_face_of[to_check[k]] = 1;
@@ -242,10 +248,14 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
           const bool in = face_needs(g, positions, f, body_b, options.face_clearance, need);
           faces_in[blk] += in;
           if (round == 0) face_inside_before[f] = in;
+          const bool last_round = round + 1 >= std::max(1, options.max_rounds);
+          if (!last_round && std::any_of(face.begin(), face.end(), [&](Index v) { return constrained[v] != 0; })) continue;
           for (std::size_t i = 0; i < face.size(); ++i)
             if (need[i].active) face_found[blk].emplace_back(face[i], need[i]);
         }
     });
+    for (const auto& list : found)
+      for (const auto& ic : list) constrained[ic.first] = 0;
     std::vector<std::pair<Index, Constraint>> by_vertex;
     for (const auto& list : found) by_vertex.insert(by_vertex.end(), list.begin(), list.end());
     const std::size_t vertex_constraints = by_vertex.size();

@@ -15,7 +15,7 @@ struct CollisionOptions {
   double clearance = 0.2;       // garment units (0.2 cm)
   int smoothing_rings = 6;      // how far (in edges) a correction spreads
   int smoothing_passes = 12;    // Jacobi passes of the displacement field
-  int max_rounds = 3;           // re-check and repeat while something is still too close
+  int max_rounds = 5;           // re-check and repeat while something is still too close
   double near_band = 1.0;       // garment units: vertices this close to body B (before the step) are lifted off it
   double max_lift = 0.1;        // by at most this beyond what they need (0 band: no limit)
   double face_clearance = 0.05; // garment units: what points inside faces keep from body B
