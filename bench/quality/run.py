@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """The quality suite: every garment of the shared data resized to every target body
-of its sex, by Refit (full pipeline), the warp alone, MakeHuman's own proxy fit and
+of its sex (and to F_shorter and M_shorter, body A 9 % shorter, made here), by Refit
+(full pipeline), the warp alone, MakeHuman's own proxy fit (where it exists) and
 Blender's Surface Deform, scored from the written files by bench/quality/meshes.py
 (numpy and scipy only: nothing here comes from the code under test).
 
@@ -42,7 +43,11 @@ GARMENTS = {
     "male_suit": ("male_suit_on_M_ref.obj", "M_ref", None),
     "dress_soup": ("dress_soup_on_A_female.obj", "A_female", None),
 }
-TARGETS = {"A_female": ["F_heavier", "F_thinner", "F_taller"], "M_ref": ["M_heavier"]}
+TARGETS = {"A_female": ["F_heavier", "F_thinner", "F_taller", "F_shorter"], "M_ref": ["M_heavier", "M_shorter"]}
+# Bodies the shared data does not have, made here from body A: 9 % shorter, as wide
+# (its heights scaled about the soles). The garment should follow (issue 13 item 3).
+DERIVED = {"F_shorter": ("A_female", 0.91), "M_shorter": ("M_ref", 0.91)}
+DERIVED_DIR = None  # where main() writes them
 QUICK = (["skirt", "dress"], ["F_heavier", "F_thinner"])
 # Features: the hem and a front and a left profile (one side only: the garment must
 # stay symmetric all the same). Held-out profiles, scored but not features: degrees
@@ -129,9 +134,21 @@ class Case:
         file, self.body_a_name, self.spec = GARMENTS[garment]
         self.garment_path = os.path.join(data, "garments", file)
         self.a_path = os.path.join(data, "bodies", self.body_a_name + ".obj")
-        self.b_path = os.path.join(data, "bodies", target + ".obj")
+        self.b_path = os.path.join(DERIVED_DIR if target in DERIVED else os.path.join(data, "bodies"), target + ".obj")
         self.peer_path = os.path.join(data, "peer_makehuman", "%s__%s.obj" % (garment, target))
         self.features_path = os.path.join(HERE, "features", garment + ".json") if self.spec else None
+
+
+def write_derived_bodies(data, out_dir):
+    for name, (source, height) in DERIVED.items():
+        lines = open(os.path.join(data, "bodies", source + ".obj")).read().splitlines()
+        floor = min(float(l.split()[2]) for l in lines if l.startswith("v "))
+        with open(os.path.join(out_dir, name + ".obj"), "w") as f:
+            for l in lines:
+                if l.startswith("v "):
+                    x, y, z = (float(t) for t in l.split()[1:4])
+                    l = "v %.6f %.6f %.6f" % (x, floor + (y - floor) * height, z)
+                f.write(l + "\n")
 
 
 def score(case, original, faces, ids, body_a, body_b, dist_a, result, warp, curves, held, report):
@@ -297,10 +314,13 @@ def main():
                 feats, _ = feature_specs(pos, meshes.read_obj(os.path.join(data, "bodies", body + ".obj"))[0], spec)
                 with open(os.path.join(HERE, "features", g + ".json"), "w") as f:
                     json.dump(feats, f, indent=1)
-    garments, bodies = (QUICK if args.quick else (args.garments, args.bodies))
-    cases = [Case(data, g, t) for g in garments for t in TARGETS[GARMENTS[g][1]] if not bodies or t in bodies]
+    global DERIVED_DIR
     out_dir = args.out or tempfile.mkdtemp(prefix="refit-quality-")
     os.makedirs(out_dir, exist_ok=True)
+    DERIVED_DIR = out_dir
+    write_derived_bodies(data, out_dir)
+    garments, bodies = (QUICK if args.quick else (args.garments, args.bodies))
+    cases = [Case(data, g, t) for g in garments for t in TARGETS[GARMENTS[g][1]] if not bodies or t in bodies]
     results = []
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
         for case, rows in pool.map(lambda c: evaluate(args, c, out_dir), cases):

@@ -74,6 +74,7 @@ int run(const ResizeArgs& a) {
     options.surface.keep_clear_of_body = false;
     options.surface.feature_zone_rings = 0;  // no zone, no snap
     options.surface.layers = false;
+    options.surface.follow_body_scale = false;
   }
   options.collision = !(a.no_collision || paper);
   options.symmetry = parse_symmetry(!a.symmetry.empty() ? a.symmetry : paper ? "none" : "auto");
@@ -212,9 +213,13 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
       ->group(kAdvanced);
   app.add_flag("--encode-on-warped", a->encode_on_warped, "Encode the local shape on the warped garment, not the original")
       ->group(kAdvanced);
+  app.add_flag("--absolute-size", [a](std::int64_t) { a->surface.follow_body_scale = false; },
+               "Keep the garment's original absolute size between the features (the paper's encoding) instead of "
+               "following the body's change of size and proportions")
+      ->group(kAdvanced);
   app.add_flag("--paper-surface", a->paper_surface,
                "Surface step as the paper: fan-normal frames, eq. 4 blend of the warped vertices, no smoothing, no layers, "
-               "--feature-zone 0")
+               "absolute size, --feature-zone 0")
       ->group(kAdvanced);
   app.add_option("--symmetry", a->symmetry,
                  "auto: mirror each one-sided feature about x = c when garment and body A are mirror-symmetric; "

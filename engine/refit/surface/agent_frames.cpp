@@ -192,6 +192,44 @@ std::vector<Eigen::Matrix3d> ring_rotations(const Points& from, const Points& to
   return out;
 }
 
+std::vector<Eigen::Matrix3d> group_stretches(const Points& from, const Points& to, const std::vector<Index>& group,
+                                             std::size_t min_agents) {
+  const std::size_t n = group.size();
+  // Sums per group in agent order (deterministic): count, means, then covariances.
+  std::vector<std::size_t> count(n, 0);
+  std::vector<Vec3> mean_from(n, Vec3::Zero()), mean_to(n, Vec3::Zero());
+  for (std::size_t a = 0; a < n; ++a) {
+    const Index g = group[a];
+    ++count[g];
+    mean_from[g] += row3(from, Index(a));
+    mean_to[g] += row3(to, Index(a));
+  }
+  for (std::size_t g = 0; g < n; ++g)
+    if (count[g] > 0) mean_from[g] /= double(count[g]), mean_to[g] /= double(count[g]);
+  std::vector<Eigen::Matrix3d> cff(n, Eigen::Matrix3d::Zero()), ctf(n, Eigen::Matrix3d::Zero());
+  for (std::size_t a = 0; a < n; ++a) {
+    const Index g = group[a];
+    const Vec3 df = row3(from, Index(a)) - mean_from[g], dt = row3(to, Index(a)) - mean_to[g];
+    cff[g] += df * df.transpose();
+    ctf[g] += dt * df.transpose();
+  }
+  std::vector<Eigen::Matrix3d> stretch_of(n, Eigen::Matrix3d::Identity());
+  for (std::size_t g = 0; g < n; ++g) {
+    if (count[g] < min_agents) continue;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> spread(cff[g]);
+    const Vec3 ev = spread.eigenvalues();  // ascending
+    if (!(ev[2] > 0.0) || !(ev[0] > 1e-4 * ev[2])) continue;  // a flat piece: its normal's scale is unknown
+    const Eigen::Matrix3d A = ctf[g] * cff[g].inverse();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> polar(A.transpose() * A);
+    const Vec3 s2 = polar.eigenvalues();
+    if (!(s2[0] > 0.0) || !A.allFinite()) continue;
+    stretch_of[g] = polar.eigenvectors() * s2.cwiseSqrt().asDiagonal() * polar.eigenvectors().transpose();
+  }
+  std::vector<Eigen::Matrix3d> out(n);
+  for (std::size_t a = 0; a < n; ++a) out[a] = stretch_of[group[a]];
+  return out;
+}
+
 std::vector<Eigen::Matrix3d> frame_rotations(const AgentFrames& before, const AgentFrames& after) {
   const std::size_t n = before.axes.size();
   std::vector<Eigen::Matrix3d> out(n, Eigen::Matrix3d::Identity());

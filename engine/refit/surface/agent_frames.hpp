@@ -48,6 +48,18 @@ AgentFrames agent_frames(const Points& x, const Csr& ring, const std::vector<std
 /// two non-collinear edges. Exactly the identity (to rounding) when from == to.
 std::vector<Eigen::Matrix3d> ring_rotations(const Points& from, const Points& to, const Csr& ring);
 
+/// Per agent the stretch S (symmetric, positive) of the least-squares affine map
+/// A = R S that carries its whole group (agents with the same `group` id: a
+/// connected piece) from `from` to `to`. Beyond the paper: the surface step
+/// scales the local shape encoding by it, so the garment keeps its shape but
+/// follows the body's change of size and proportions (a 9 % shorter body gives a
+/// 9 % shorter jacket); a uniform affine change of the warp is then reproduced
+/// exactly. One map per piece, not per agent: a local fit would copy the body's
+/// bumps that the surface step is there to remove. Identity for pieces of fewer
+/// than `min_agents` agents or with a flat or degenerate spread.
+std::vector<Eigen::Matrix3d> group_stretches(const Points& from, const Points& to, const std::vector<Index>& group,
+                                             std::size_t min_agents = 10);
+
 /// Rotation from `before` to `after` frames per agent (after.axes * before.axes^T;
 /// identity where either frame is invalid): the paper's fan frames as rotations,
 /// so reconstruct_rotations with these and empty weights is the paper's eq.-4

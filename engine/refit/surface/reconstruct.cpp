@@ -161,6 +161,7 @@ void SurfaceBinding::smooth_displacements(const Points& before, const std::vecto
 // With encode_on_warped the target shape is the warp's, so its detail stays.
 // Anchored agents that had no solved agent within reach hand their vertices back as warped.
 Points SurfaceBinding::reconstruct(const Points& warped, const Points& before, const Points& x,
+                                   const std::vector<Eigen::Matrix3d>& stretch,
                                    const std::vector<std::uint8_t>& anchored_kept, bool some_anchored_kept) const {
   const bool orig = options_.emit_from_original && !options_.encode_on_warped;
   const Points& from = orig ? original_agents_ : before;
@@ -170,6 +171,9 @@ Points SurfaceBinding::reconstruct(const Points& warped, const Points& before, c
   } else {
     rot = frame_rotations(agent_frames(from, ring_, ring_open_, flip_), agent_frames(x, ring_, ring_open_, flip_));
   }
+  // The original offsets to the agents stretch as the encoding did.
+  if (orig && !stretch.empty())
+    for (std::size_t a = 0; a < rot.size(); ++a) rot[a] = rot[a] * stretch[a];
   std::vector<std::uint8_t> keep;
   if (orig && some_anchored_kept) keep = anchored_kept;
   return reconstruct_rotations(orig ? original_vertices_ : warped, from, x, rot, reach_, reach_weight_, nearest_, keep,

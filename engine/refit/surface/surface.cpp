@@ -204,6 +204,14 @@ SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
   } else if (options_.rotate_encoding) {
     turn = ring_rotations(original_agents_, before, ring_);
   }
+  // Body-proportional size (group_stretches): h scaled by each piece's stretch
+  // from the original to the warp. The paper's encoding keeps the absolute size.
+  std::vector<Eigen::Matrix3d> stretch;
+  if (options_.follow_body_scale && !options_.encode_on_warped) {
+    stretch = group_stretches(original_agents_, before, group_);
+    if (turn.empty()) turn = stretch;
+    else for (std::size_t a = 0; a < n; ++a) turn[a] = turn[a] * stretch[a];
+  }
   const AgentRows& rows = options_.encode_on_warped ? warped_rows : rows_;
   st.ms.encode = clock.ms();
   clock.reset();
@@ -274,7 +282,7 @@ SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
   if (n == 0) {
     res.positions = warped;
   } else {
-    res.positions = reconstruct(warped, before, x, anchored_kept, st.anchored > st.anchored_followed);
+    res.positions = reconstruct(warped, before, x, stretch, anchored_kept, st.anchored > st.anchored_followed);
   }
   std::vector<std::uint8_t> kept_vertex;
   if (options_.keep_near_vertices && n > 0) {

@@ -72,6 +72,9 @@ struct SurfaceOptions {
   double layer_min_area = 8.0;     // a piece is a layer from this face area on, in voxel areas (h^2)
   double layer_join = 0.1;         // pieces whose face boundaries come this close (in voxels) are one layer
   // Beyond the paper (each documented where it is used; false gives the paper's way):
+  bool follow_body_scale = true;   // scale the local shape encoding by each piece's stretch from the original to the
+                                   // warp (group_stretches): the garment follows the body's change of size and
+                                   // proportions; false: the paper's absolute size
   bool rotate_encoding = false;    // turn each h (eq. 12) with the agent's ring rotation from the original to the warp (measured worse: see apply)
   bool fit_rotations = true;       // frames as least-squares ring rotations instead of fan normal + one-neighbour tangent
   bool smooth_blend = true;        // vertex blend with a smooth compact kernel bound on the original instead of eq. 4
@@ -216,6 +219,7 @@ class SurfaceBinding {
                               std::vector<std::uint8_t>& anchored_kept) const;
   void smooth_displacements(const Points& before, const std::vector<std::uint8_t>& fr, Points& x) const;
   Points reconstruct(const Points& warped, const Points& before, const Points& x,
+                     const std::vector<Eigen::Matrix3d>& stretch,
                      const std::vector<std::uint8_t>& anchored_kept, bool some_anchored_kept) const;
   std::vector<std::uint8_t> keep_near_vertices(const Points& warped, const Points& before,
                                                const std::vector<double>& body_distance,
