@@ -103,6 +103,10 @@ TEST(FeatureFile, ErrorsNameTheFileAndTheFeature) {
       {R"({"name": "o", )" + kPlane + R"(, "curve": {"kind": "bspline", "closed": true, "control_points": [[0,0,0],[1,0,0],[2,1,0],[3,0,0]]}, "samples": 2})",
        "a closed curve needs at least 3 samples"},
       {R"({"name": "p", )" + kPlane + R"(, "curve": {"kind": "slice", "near": [0,0,0], "from": [1,0,0]}, "samples": 9})", "must be given together"},
+      {R"({"name": "q", )" + kPlane + R"(, "curve": {"kind": "slice", "near": [0,0,0]}, "samples": 5001})",
+       "'samples' is out of range (5001; at most 5000)"},
+      {R"({"name": "r", )" + kPlane + R"(, "curve": {"kind": "slice", "near": [0,0,0], "control_points": 501}, "samples": 9})",
+       "curve 'control_points' is out of range (501; at most 500)"},
   };
   for (const Case& c : cases) {
     const std::string msg = error_of(one(c.feature));

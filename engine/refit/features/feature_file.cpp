@@ -50,11 +50,14 @@ Vec3 vec3(const json& v, const Ctx& c, const std::string& what, bool is_position
   return is_position ? Vec3(p * c.scale) : p;
 }
 
-std::size_t count(const json& v, const Ctx& c, const std::string& what) {
+// Counts are bounded so that a feature file cannot make a run take minutes
+// (issue 17: 1e5 samples took 75 s, 1e4 fitted control points over 120 s).
+std::size_t count(const json& v, const Ctx& c, const std::string& what, double most) {
   if (!v.is_number_integer() && !(v.is_number() && std::floor(v.get<double>()) == v.get<double>()))
     c.fail(what + " must be an integer");
   const double d = v.get<double>();
-  if (d < 0 || d > 1e8) c.fail(what + " is out of range (" + v.dump() + ")");
+  if (d < 0 || d > most)
+    c.fail(what + " is out of range (" + v.dump() + "; at most " + std::to_string(static_cast<long long>(most)) + ")");
   return static_cast<std::size_t>(d);
 }
 
@@ -117,7 +120,7 @@ FeatureSpec parse_feature(const json& f, std::size_t index, const Ctx& root) {
   if (s.kind == CurveKind::bspline) {
     check_keys(curve, {"kind", "degree", "closed", "control_points"}, c, "'curve'");
     if (curve.contains("degree")) {
-      const std::size_t d = count(curve["degree"], c, "curve 'degree'");
+      const std::size_t d = count(curve["degree"], c, "curve 'degree'", 1e8);
       if (d < 1 || d > 15) c.fail("curve 'degree' must be between 1 and 15, got " + std::to_string(d));
       s.degree = static_cast<int>(d);
     }
@@ -152,7 +155,7 @@ FeatureSpec parse_feature(const json& f, std::size_t index, const Ctx& root) {
     if (curve.contains("control_points")) {
       if (curve["control_points"].is_array())
         c.fail("a slice's 'control_points' is the number of control points of its fitted B-spline, not a list");
-      s.fit_control_points = count(curve["control_points"], c, "curve 'control_points'");
+      s.fit_control_points = count(curve["control_points"], c, "curve 'control_points'", kMaxFitControlPoints);
     }
     if (s.fit_control_points < static_cast<std::size_t>(s.degree) + 1)
       c.fail("a slice needs at least " + std::to_string(s.degree + 1) + " control points, got " +
@@ -163,7 +166,7 @@ FeatureSpec parse_feature(const json& f, std::size_t index, const Ctx& root) {
     s.closed = true;
   }
 
-  s.samples = count(require(f, "samples", c, "the feature"), c, "'samples'");
+  s.samples = count(require(f, "samples", c, "the feature"), c, "'samples'", kMaxSamples);
   // A slice's closedness is known only after cutting: check the open minimum
   // then (build_feature_curves) and the closed minimum now.
   const bool closed_now = s.kind == CurveKind::slice ? true : s.closed;

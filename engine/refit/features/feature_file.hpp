@@ -65,5 +65,9 @@ std::vector<FeatureSpec> read_feature_file(const std::string& path, const std::s
 /// The fewest samples a curve may have: 5 open (eqs. 5-6 need two neighbours on
 /// each side), 3 closed.
 inline std::size_t min_samples(bool closed) { return closed ? 3 : 5; }
+/// Largest 'samples' of a feature and 'control_points' of a fitted slice the
+/// feature file accepts: a run stays within seconds (bench/README.md).
+inline constexpr double kMaxSamples = 5000;
+inline constexpr double kMaxFitControlPoints = 500;
 
 }  // namespace refit
