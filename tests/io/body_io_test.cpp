@@ -93,6 +93,18 @@ TEST(BodyIo, BadBodiesNameTheFile) {
   expect_error("missing.off", "", "cannot open");
   expect_error("garbage.ply", "this is not a ply file\n", "cannot read");
   expect_error("body.xyz", "1 2 3\n", "unknown body format");
+  // Counts in a header that the file cannot hold are refused before anything is allocated.
+  expect_error("huge.ply", "ply\nformat ascii 1.0\nelement vertex 99999999999\nproperty float x\nend_header\n",
+               "declares 99999999999 vertices but the file has only 76 bytes");
+  expect_error("huge.off", "OFF\n99999999 1 0\n0 0 0\n", "declares 99999999 vertices");
+  expect_error("faces.ply",
+               "ply\nformat binary_little_endian 1.0\nelement vertex 0\nelement face 4000000000\n"
+               "property list uchar int vertex_indices\nend_header\n",
+               "declares 4000000000 faces");
+  expect_error("bad.ply", "ply\nformat ascii 1.0\nelement vertex -3\nend_header\n", "bad vertex count '-3'");
+  std::string stl(80, ' ');
+  stl += std::string("\xff\xff\xff\x0f", 4);
+  expect_error("huge.stl", stl, "declares 268435455 triangles but the file has only 84 bytes");
 
   BodyMesh b;
   b.vertices = Points::Zero(3, 3);
