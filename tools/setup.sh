@@ -2,14 +2,15 @@
 # Sets up a fresh Debian machine for Refit and builds it.
 #   bash tools/setup.sh          install packages, configure and build (Release)
 #   bash tools/setup.sh demo     ... then run `refit demo` and say where its output is
-#   bash tools/setup.sh test     ... then run the whole test suite through CTest
+#   bash tools/setup.sh test     ... then run the whole test suite through CTest, again under the
+#                                sanitizers, and each fuzz target for 30 s
 # Installing is idempotent and quiet when every package is already there.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-packages=(cmake ninja-build g++ pkg-config libtbb-dev libeigen3-dev libembree-dev libopenmesh-dev
+packages=(cmake ninja-build g++ pkg-config libtbb-dev libeigen3-dev libembree-dev
           libgtest-dev libgmock-dev libbenchmark-dev libnanoflann-dev nlohmann-json3-dev libstb-dev
-          libcli11-dev python3-numpy python3-scipy)
+          libcli11-dev python3-numpy python3-scipy clang libclang-rt-14-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -35,6 +36,14 @@ case "${1:-build}" in
     ;;
   test)
     ctest --preset release -j "$jobs"
+    # The same suite under AddressSanitizer and UBSan, then each libFuzzer target
+    # for 30 s (tests/fuzz/; bench/fuzz.sh runs them longer).
+    cmake --preset sanitize >/dev/null
+    cmake --build --preset sanitize -j "$jobs"
+    ctest --preset sanitize -j "$jobs"
+    cmake --preset fuzz >/dev/null
+    cmake --build --preset fuzz -j "$jobs"
+    ctest --preset fuzz -j "$jobs"
     ;;
   *) echo "usage: tools/setup.sh [build|demo [DIR]|test]" >&2; exit 2 ;;
 esac

@@ -1,7 +1,8 @@
 #pragma once
 // Body meshes from files: OBJ with the engine's own parser, PLY, OFF and STL
-// through OpenMesh. Polygons are fan-split (a-b-c, a-c-d, ...) the same way for
-// every format, so two bodies with the same faces get the same triangles.
+// with small readers of our own (mesh_formats.hpp). Polygons are fan-split
+// (a-b-c, a-c-d, ...) the same way for every format, so two bodies with the same
+// faces get the same triangles.
 #include <refit/body/body_mesh.hpp>
 
 #include <string>
