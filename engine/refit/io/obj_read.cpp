@@ -152,17 +152,21 @@ class ChunkParser {
 
   // Turns a 1-based (or negative, relative) OBJ index into a 0-based one.
   Index resolve(long long raw, std::size_t cur, std::size_t total, const char* what) const {
+    // "vertex" -> "vertices" (issue 17 found "vertexs"); "normal" -> "normals".
+    auto count_of = [&](std::size_t n) {
+      const std::string w(what);
+      return std::to_string(n) + " " + (n == 1 ? w : w == "vertex" ? "vertices" : w + "s");
+    };
     if (raw == 0) fail(std::string(what) + " index 0 is invalid (OBJ indices start at 1)");
     if (raw > 0) {
       if (static_cast<unsigned long long>(raw) > total)
-        fail(std::string(what) + " index " + std::to_string(raw) + " out of range (the file has " +
-             std::to_string(total) + " " + what + (total == 1 ? "" : "s") + ")");
+        fail(std::string(what) + " index " + std::to_string(raw) + " out of range (the file has " + count_of(total) + ")");
       return static_cast<Index>(raw - 1);
     }
     // 0 - raw in unsigned arithmetic: -raw would overflow for LLONG_MIN.
     if (0ULL - static_cast<unsigned long long>(raw) > cur)
       fail("relative " + std::string(what) + " index " + std::to_string(raw) + " out of range (only " +
-           std::to_string(cur) + " " + what + (cur == 1 ? "" : "s") + " before this line)");
+           count_of(cur) + " before this line)");
     return static_cast<Index>(static_cast<long long>(cur) + raw);
   }
 
