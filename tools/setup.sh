@@ -10,7 +10,8 @@ cd "$(dirname "$0")/.."
 
 packages=(cmake ninja-build g++ pkg-config libtbb-dev libeigen3-dev libembree-dev
           libgtest-dev libgmock-dev libbenchmark-dev libnanoflann-dev nlohmann-json3-dev libstb-dev
-          libcli11-dev python3-numpy python3-scipy clang libclang-rt-14-dev)
+          libcli11-dev python3-numpy python3-scipy clang libclang-rt-14-dev
+          pybind11-dev python3-dev python3-pytest)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
