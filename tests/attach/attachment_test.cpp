@@ -1,7 +1,10 @@
 // Points bound to a garment's surface and carried to deformed states.
 #include <refit/attach/attachment.hpp>
+#include <refit/body/body_surface.hpp>
 
 #include <gtest/gtest.h>
+
+#include <random>
 
 namespace refit {
 namespace {
@@ -51,4 +54,66 @@ TEST(Attach, GarmentOfBarePointsUsesTheNearestVertex) {
 }
 
 }  // namespace
+TEST(Attach, ClosestElementMatchesAScanOfEveryElement) {
+  // Faces of very different sizes (a 1 mm grid beside a 2 m quad), a long hanging
+  // line and loose points; samples on, near and far from them. The element tree
+  // must find the same closest distance as a scan over every element.
+  Garment g;
+  std::vector<Vec3> v;
+  for (int i = 0; i <= 30; ++i)
+    for (int j = 0; j <= 30; ++j) v.push_back({0.1 * i, 0.1 * j, 0.0});
+  for (int i = 0; i < 30; ++i)
+    for (int j = 0; j < 30; ++j) {
+      const Index a = Index(31 * i + j);
+      g.faces.push_row(std::array<Index, 4>{a, a + 31, a + 32, a + 1});
+    }
+  const Index big = Index(v.size());
+  for (const Vec3& c : {Vec3(5, -100, -100), Vec3(5, 100, -100), Vec3(5, 100, 100), Vec3(5, -100, 100)}) v.push_back(c);
+  g.faces.push_row(std::array<Index, 4>{big, Index(big + 1), Index(big + 2), Index(big + 3)});
+  v.push_back({-50, 0, 3});
+  v.push_back({50, 0, 3});
+  g.lines.push_row(std::array<Index, 2>{Index(big + 4), Index(big + 5)});
+  v.push_back({1, 1, -2});
+  v.push_back({-7, 4, 9});
+  g.points.push_row(std::array<Index, 2>{Index(big + 6), Index(big + 7)});
+  g.positions.resize(Eigen::Index(v.size()), 3);
+  for (std::size_t i = 0; i < v.size(); ++i) g.positions.row(Eigen::Index(i)) = v[i].transpose();
+
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> near(-0.5, 3.5), far(-120.0, 120.0);
+  Points samples(2000, 3);
+  for (Eigen::Index s = 0; s < samples.rows(); ++s)
+    samples.row(s) = s % 2 ? Vec3(near(rng), near(rng), 0.05 * near(rng)).transpose()
+                           : Vec3(far(rng), far(rng), far(rng)).transpose();
+  samples.row(0) = g.positions.row(40);  // exactly on a vertex shared by four faces
+  const SurfaceAttachment at = attach_points(g, samples);
+
+  const auto distance_to = [&](const Vec3& p, const std::array<Index, 3>& e, int corners) {
+    const Vec3 a = row3(g.positions, e[0]), b = row3(g.positions, e[1]), c = row3(g.positions, e[2]);
+    if (corners == 1) return (p - a).norm();
+    if (corners == 2) {
+      const double t = std::clamp((p - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+      return (p - (a + t * (b - a))).norm();
+    }
+    return (p - closest_point_on_triangle(p, a, b, c)).norm();
+  };
+  for (Eigen::Index s = 0; s < samples.rows(); ++s) {
+    const Vec3 p = samples.row(s).transpose();
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t f = 0; f < g.faces.rows(); ++f) {
+      const auto r = g.faces.row(f);
+      for (std::size_t k = 1; k + 1 < r.size(); ++k) best = std::min(best, distance_to(p, {r[0], r[k], r[k + 1]}, 3));
+    }
+    best = std::min(best, distance_to(p, {big + 4, big + 5, big + 5}, 2));
+    best = std::min(best, std::min(distance_to(p, {big + 6, big + 6, big + 6}, 1),
+                                   distance_to(p, {big + 7, big + 7, big + 7}, 1)));
+    ASSERT_NEAR(at.offset.row(s).norm(), best, 1e-12 * (1.0 + best)) << "sample " << s;
+  }
+  EXPECT_EQ(at.offset.row(0).norm(), 0.0);
+  // Of the four faces at that vertex, the first in file order: face 8 (corners
+  // 8, 39, 40, 9), its first fan triangle, all the weight on vertex 40.
+  EXPECT_EQ(at.vertex[0], (std::array<Index, 3>{8, 39, 40}));
+  EXPECT_NEAR(at.weight[0][2], 1.0, 1e-12);
+}
+
 }  // namespace refit

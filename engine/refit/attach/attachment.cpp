@@ -1,9 +1,10 @@
 #include <refit/attach/attachment.hpp>
 
 #include <refit/body/body_surface.hpp>
-#include <refit/body/centre_tree.hpp>
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
+
+#include <embree3/rtcore.h>
 
 #include <algorithm>
 #include <cmath>
@@ -22,15 +23,6 @@ struct Candidate {
   Vec3 point = Vec3::Zero();
 };
 
-std::vector<Candidate> merge_chunks(const std::vector<std::vector<Candidate>>& chunks, std::size_t n) {
-  std::vector<Candidate> best(n);
-  for (const auto& chunk : chunks)
-    for (std::size_t s = 0; s < n; ++s)
-      if (chunk[s].d2 < best[s].d2) best[s] = chunk[s];
-  return best;
-}
-
-constexpr std::size_t kChunk = 1 << 16;
 
 }  // namespace
 
@@ -82,67 +74,167 @@ void for_each_element(const Garment& g, std::size_t begin, std::size_t end, Visi
 
 }  // namespace
 
-SurfaceAttachment attach_points(const Garment& original, const Points& samples) {
+namespace {
+
+float float_below(double v) {
+  float f = static_cast<float>(v);
+  return double(f) > v ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+}
+float float_above(double v) {
+  float f = static_cast<float>(v);
+  return double(f) < v ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+}
+
+}  // namespace
+
+// The garment's elements in for_each_element order (their id) in an Embree BVH
+// (user geometry: triangles, segments and points alike), for exact closest-element
+// queries whose cost does not grow with the size of the largest element.
+class GarmentLocator::ElementIndex {
+ public:
+  // The elements of `g` over the positions `x`.
+  ElementIndex(const Garment& g, const Points& x) : x_(x) {
+    for_each_element(g, 0, g.faces.rows() + g.lines.rows() + g.points.rows(),
+                     [&](const std::array<Index, 3>& v, int corners) { elements_.push_back({v, corners}); });
+    device_ = rtcNewDevice(nullptr);
+    scene_ = rtcNewScene(device_);
+    rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_LOW);
+    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
+    // The near radius: twice the median element's bounding box diagonal.
+    {
+      std::vector<float> size(std::min<std::size_t>(elements_.size(), 4096));
+      for (std::size_t i = 0; i < size.size(); ++i) {
+        const auto& v = elements_[i * elements_.size() / size.size()].v;
+        Vec3 lo = row3(x_, v[0]), hi = lo;
+        for (int k = 1; k < 3; ++k) lo = lo.cwiseMin(row3(x_, v[k])), hi = hi.cwiseMax(row3(x_, v[k]));
+        size[i] = float((hi - lo).norm());
+      }
+      std::nth_element(size.begin(), size.begin() + size.size() / 2, size.end());
+      near_ = size.empty() ? 0.0f : 2.0f * size[size.size() / 2];
+    }
+    rtcSetGeometryUserPrimitiveCount(geom, static_cast<unsigned>(elements_.size()));
+    rtcSetGeometryUserData(geom, this);
+    rtcSetGeometryBoundsFunction(geom, &ElementIndex::bounds, this);
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(scene_, geom);
+    rtcReleaseGeometry(geom);
+    rtcCommitScene(scene_);
+    if (rtcGetDeviceError(device_) != RTC_ERROR_NONE) throw Error("Embree: building the garment's element tree failed");
+  }
+  ~ElementIndex() {
+    rtcReleaseScene(scene_);
+    rtcReleaseDevice(device_);
+  }
+  ElementIndex(const ElementIndex&) = delete;
+  ElementIndex& operator=(const ElementIndex&) = delete;
+
+  // The closest point of p on the garment's elements; among equally close
+  // elements the first (lowest id), as a scan in element order would find.
+  Candidate closest(const Vec3& p) const {
+    Query q{this, p, {}};
+    RTCPointQuery pq;
+    pq.x = static_cast<float>(p.x());
+    pq.y = static_cast<float>(p.y());
+    pq.z = static_cast<float>(p.z());
+    pq.time = 0.0f;
+    pq.radius = std::numeric_limits<float>::infinity();
+    RTCPointQueryContext ctx;
+    rtcInitPointQueryContext(&ctx);
+    // A near radius first (most samples lie on the garment), everything if nothing is that near.
+    pq.radius = near_;
+    rtcPointQuery(scene_, &pq, &ctx, &ElementIndex::visit, &q);
+    const double pad = 1e-6 * p.cwiseAbs().maxCoeff() + 1e-30;
+    const double sure = double(near_) * (1.0 - 1e-6) - pad;
+    if (!(q.best.d2 <= sure * sure)) {
+      // Nothing nearer than the best so far can be missed by a query that reaches it.
+      pq.radius = std::isfinite(q.best.d2) ? float_above(std::sqrt(q.best.d2) * (1.0 + 1e-6) + pad)
+                                           : std::numeric_limits<float>::infinity();
+      rtcInitPointQueryContext(&ctx);
+      rtcPointQuery(scene_, &pq, &ctx, &ElementIndex::visit, &q);
+    }
+    return q.best;
+  }
+
+ private:
+  struct Element {
+    std::array<Index, 3> v;
+    int corners;
+  };
+  struct Query {
+    const ElementIndex* index;
+    Vec3 p;
+    Candidate best;
+    std::size_t best_id = std::numeric_limits<std::size_t>::max();
+  };
+
+  static void bounds(const RTCBoundsFunctionArguments* args) {
+    const auto* self = static_cast<const ElementIndex*>(args->geometryUserPtr);
+    const auto& v = self->elements_[args->primID].v;
+    Vec3 lo = row3(self->x_, v[0]), hi = lo;
+    for (int k = 1; k < 3; ++k) lo = lo.cwiseMin(row3(self->x_, v[k])), hi = hi.cwiseMax(row3(self->x_, v[k]));
+    RTCBounds* b = args->bounds_o;
+    b->lower_x = float_below(lo.x()), b->lower_y = float_below(lo.y()), b->lower_z = float_below(lo.z());
+    b->upper_x = float_above(hi.x()), b->upper_y = float_above(hi.y()), b->upper_z = float_above(hi.z());
+  }
+
+  static bool visit(RTCPointQueryFunctionArguments* args) {
+    auto* q = static_cast<Query*>(args->userPtr);
+    const ElementIndex& self = *q->index;
+    const std::size_t id = args->primID;
+    const Candidate c = closest_on_element(q->p, self.x_, self.elements_[id].v, self.elements_[id].corners);
+    if (!(c.d2 < q->best.d2 || (c.d2 == q->best.d2 && id < q->best_id))) return false;
+    q->best = c;
+    q->best_id = id;
+    // Slightly more than the double distance, plus the query point's rounding to
+    // float, so an equally close element is never culled.
+    const double pad = 1e-6 * q->p.cwiseAbs().maxCoeff() + 1e-30;
+    args->query->radius = float_above(std::sqrt(c.d2) * (1.0 + 1e-6) + pad);
+    return true;
+  }
+
+  const Points& x_;
+  std::vector<Element> elements_;
+  RTCDevice device_ = nullptr;
+  RTCScene scene_ = nullptr;
+  float near_ = 0.0f;
+};
+
+GarmentLocator::GarmentLocator(const Garment& original) {
+  if (original.vertex_count() == 0) throw Error("attaching points: the garment has no vertices");
+  const bool no_elements = original.faces.rows() + original.lines.rows() + original.points.rows() == 0;
+  if (no_elements) {
+    std::vector<Index> all(original.vertex_count());
+    for (std::size_t v = 0; v < all.size(); ++v) all[v] = Index(v);
+    bare_.points.push_row(all);
+  }
+  index_ = std::make_unique<ElementIndex>(no_elements ? bare_ : original, original.positions);
+}
+
+GarmentLocator::~GarmentLocator() = default;
+
+SurfaceAttachment GarmentLocator::attach(const Points& samples) const {
   const std::size_t n = static_cast<std::size_t>(samples.rows());
-  const std::size_t ne = original.faces.rows() + original.lines.rows() + original.points.rows();
   SurfaceAttachment at;
   at.vertex.resize(n);
   at.weight.resize(n);
   at.offset.resize(samples.rows(), 3);
-  if (n == 0) return at;
-  if (ne == 0 && original.vertex_count() == 0) throw Error("attaching points: the garment has no vertices");
-  const auto sample = [&](std::size_t s) { return Vec3(samples.row(static_cast<Eigen::Index>(s)).transpose()); };
-  const Points& x = original.positions;
-
-  // 1. Each element offers its closest point to the samples within its bounding
-  // sphere grown by `slack`: linear in the garment, and exact for every sample
-  // whose closest element is nearer than `slack` (feature samples lie on the surface).
-  const Vec3 lo = samples.colwise().minCoeff().transpose(), hi = samples.colwise().maxCoeff().transpose();
-  const double slack = std::max(1e-9, 0.02 * (hi - lo).norm());
-  const PointTree tree(samples);
-  const std::size_t chunks = (ne + kChunk - 1) / kChunk;
-  std::vector<std::vector<Candidate>> per_chunk(chunks, std::vector<Candidate>(n));
-  parallel_for(0, chunks, 1, [&](std::size_t cb, std::size_t ce) {
-    std::vector<std::pair<Index, double>> near;
-    for (std::size_t c = cb; c < ce; ++c)
-      for_each_element(original, c * kChunk, std::min(ne, (c + 1) * kChunk), [&](const std::array<Index, 3>& v, int corners) {
-        const Vec3 centre = (row3(x, v[0]) + row3(x, v[1]) + row3(x, v[2])) / 3.0;
-        double r = 0.0;
-        for (Index k : v) r = std::max(r, (row3(x, k) - centre).norm());
-        tree.within(centre, (r + slack) * (r + slack), near);
-        for (const auto& [s, d2] : near) {
-          const Candidate cand = closest_on_element(sample(std::size_t(s)), x, v, corners);
-          Candidate& best = per_chunk[c][std::size_t(s)];
-          if (cand.d2 < best.d2) best = cand;
-        }
-      });
-  });
-  std::vector<Candidate> best = merge_chunks(per_chunk, n);
-
-  // 2. The rare sample farther than `slack` from every element: all elements (or,
-  // for a garment of bare vertices, all vertices).
-  parallel_for(0, n, 1, [&](std::size_t sb, std::size_t se) {
+  // Work grows with the samples and the garment, not with their product.
+  parallel_for(0, n, 256, [&](std::size_t sb, std::size_t se) {
     for (std::size_t s = sb; s < se; ++s) {
-      if (best[s].d2 <= slack * slack) continue;
-      const Vec3 p = sample(s);
-      for_each_element(original, 0, ne, [&](const std::array<Index, 3>& v, int corners) {
-        const Candidate cand = closest_on_element(p, x, v, corners);
-        if (cand.d2 < best[s].d2) best[s] = cand;
-      });
-      if (ne == 0)
-        for (Index v = 0; v < Index(original.vertex_count()); ++v) {
-          const Candidate cand = closest_on_element(p, x, {v, v, v}, 1);
-          if (cand.d2 < best[s].d2) best[s] = cand;
-        }
+      const Vec3 p = samples.row(static_cast<Eigen::Index>(s)).transpose();
+      const Candidate best = index_->closest(p);
+      at.vertex[s] = best.vertex;
+      at.weight[s] = best.weight;
+      // Keep the sample's small offset from the surface as it was.
+      at.offset.row(static_cast<Eigen::Index>(s)) = (p - best.point).transpose();
     }
   });
-  for (std::size_t s = 0; s < n; ++s) {
-    at.vertex[s] = best[s].vertex;
-    at.weight[s] = best[s].weight;
-    // Keep the sample's small offset from the surface as it was.
-    at.offset.row(static_cast<Eigen::Index>(s)) = (sample(s) - best[s].point).transpose();
-  }
   return at;
+}
+
+SurfaceAttachment attach_points(const Garment& original, const Points& samples) {
+  if (samples.rows() == 0) return {{}, {}, Points(0, 3)};
+  return GarmentLocator(original).attach(samples);
 }
 
 Vec3 carry_one(const SurfaceAttachment& at, const Points& result, Index i) {

@@ -4,6 +4,7 @@
 #include <refit/core/garment.hpp>
 
 #include <array>
+#include <memory>
 #include <vector>
 
 namespace refit {
@@ -17,7 +18,27 @@ struct SurfaceAttachment {
   Points offset;
 };
 
-/// Attaches `samples` to the original garment (bind once).
+/// The original garment's elements in a tree, made once for any number of
+/// attach() calls (the binding attaches the mirror images of all vertices and
+/// the feature samples). Keeps references to `original`, which must outlive it.
+class GarmentLocator {
+ public:
+  explicit GarmentLocator(const Garment& original);
+  ~GarmentLocator();
+  GarmentLocator(const GarmentLocator&) = delete;
+  GarmentLocator& operator=(const GarmentLocator&) = delete;
+
+  /// Each sample's closest point on the elements (among equally close ones, the
+  /// first in file order: faces, then lines, then points).
+  SurfaceAttachment attach(const Points& samples) const;
+
+ private:
+  class ElementIndex;
+  std::unique_ptr<ElementIndex> index_;
+  Garment bare_;  // a garment without f, l or p elements attaches to its vertices
+};
+
+/// GarmentLocator(original).attach(samples), for a single set of samples.
 SurfaceAttachment attach_points(const Garment& original, const Points& samples);
 
 /// The attached points on another state of the garment (same vertex order).

@@ -139,7 +139,7 @@ void PointTree::within(const Vec3& p, double r2, std::vector<std::pair<Index, do
   out.clear();
   if (size() == 0) return;
   nanoflann::SearchParams params;
-  params.sorted = true;
+  params.sorted = false;  // sorted below, ties by index
   impl_->tree->radiusSearch(p.data(), r2, out, params);
   // nanoflann sorts by distance only; break ties by index so results never depend on tree layout.
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) {

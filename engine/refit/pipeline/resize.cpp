@@ -8,6 +8,7 @@
 #include <refit/pipeline/units.hpp>
 
 #include <limits>
+#include <optional>
 
 namespace refit {
 
@@ -115,12 +116,19 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
   bind_report_["warp"] = clock.ms();
 
   if (options_.stage == Stage::Warp) return;
+  clock.reset();
   // Each garment vertex's mirror image, found on the garment's surface (meshes need not be vertex-symmetric).
   const double plane_x = mirror_plane_x(body_a_.mesh().vertices);
+  // The garment's elements in a tree, made once for the mirror images and the feature samples.
+  std::optional<GarmentLocator> locator;
+  const auto locate = [&]() -> const GarmentLocator& {
+    if (!locator) locator.emplace(*garment_);
+    return *locator;
+  };
   SurfaceAttachment mirror_at;
   std::vector<double> mirror_distance;
   if (options_.symmetry != SymmetryMode::None) {
-    mirror_at = attach_points(*garment_, mirror_x(garment_->positions, plane_x));
+    mirror_at = locate().attach(mirror_x(garment_->positions, plane_x));
     for (Eigen::Index i = 0; i < mirror_at.offset.rows(); ++i) mirror_distance.push_back(mirror_at.offset.row(i).norm());
   }
   const SymmetryCheck sym = check_symmetry(plane_x, mirror_distance, body_a_.mesh().vertices,
@@ -136,6 +144,7 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
   symmetry_report_ = {{"plane_x", sym.plane_x},          {"garment_error", sym.garment_error},
                       {"body_a_error", sym.body_error},  {"tolerance", sym.tolerance},
                       {"symmetric", sym.symmetric},      {"mirrored_features", nlohmann::json::array()}};
+  bind_report_["symmetry"] = clock.ms();
   if (!features.empty()) {
     clock.reset();
     progress.stage("sampling " + std::to_string(features.size()) + " feature curves");
@@ -169,7 +178,7 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
     const Points all = concat_rows(samples);
     // One pass over the garment for every curve's samples; the surface binding
     // and the report's shape_error_output share it.
-    if (all.rows() > 0) feature_attachment_ = attach_points(*garment_, all);
+    if (all.rows() > 0) feature_attachment_ = locate().attach(all);
     surface_ = SurfaceBinding::bind(*garment_, all, so, all.rows() > 0 ? &feature_attachment_ : nullptr);
     bind_report_["surface"] = clock.ms();
   }
