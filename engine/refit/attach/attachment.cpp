@@ -110,7 +110,7 @@ class GarmentLocator::ElementIndex {
         size[i] = float((hi - lo).norm());
       }
       std::nth_element(size.begin(), size.begin() + size.size() / 2, size.end());
-      near_ = size.empty() ? 0.0f : 2.0f * size[size.size() / 2];
+      near_ = size.empty() ? 0.0f : 0.25f * size[size.size() / 2];
     }
     rtcSetGeometryUserPrimitiveCount(geom, static_cast<unsigned>(elements_.size()));
     rtcSetGeometryUserData(geom, this);

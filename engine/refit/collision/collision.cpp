@@ -22,10 +22,10 @@ struct Constraint {
   bool inside = false;
 };
 
-Constraint check_vertex(const Vec3& p, const BodySurface& body, double clearance) {
+// The constraint of p, given whether it is inside body B and its closest point
+// (searched at least as far as the clearance).
+Constraint constraint_at(const Vec3& p, bool in, const ClosestPoint& cp, double clearance) {
   Constraint c;
-  const bool in = body.inside(p);
-  const ClosestPoint cp = in ? body.closest(p) : body.closest_within(p, clearance);
   if (!in && !(cp.distance < clearance)) return c;
   c.active = true;
   c.inside = in;
@@ -40,6 +40,11 @@ Constraint check_vertex(const Vec3& p, const BodySurface& body, double clearance
   }
   c.amount = in ? len + clearance : clearance - len;
   return c;
+}
+
+Constraint check_vertex(const Vec3& p, const BodySurface& body, double clearance) {
+  const bool in = body.inside(p);
+  return constraint_at(p, in, in ? body.closest(p) : body.closest_within(p, clearance), clearance);
 }
 
 // Corner mean of face f.
@@ -64,8 +69,13 @@ constexpr double kFaceSamples[7][3] = {{1.0 / 3, 1.0 / 3, 1.0 / 3}, {0.5, 0.5, 0
 // lies within reach: every point of the face is within `radius` (its farthest
 // corner) of the centre, so a centre farther than radius + clearance from the
 // body clears the whole face. Returns whether a point of the face is inside.
+//
+// `outside_by` (optional): per vertex, a distance its position is known to be
+// outside body B by (0 when unknown). The open ball of that radius around the
+// corner is outside the body, so a point of the face well within it clears the
+// body without a query: on a dense garment most faces near the body need none.
 bool face_needs(const Garment& g, const Points& positions, std::size_t f, const BodySurface& body, double clearance,
-                std::vector<Constraint>& need) {
+                const std::vector<double>* outside_by, std::vector<Constraint>& need) {
   const auto face = g.faces.row(f);
   need.assign(face.size(), Constraint{});
   bool inside = false;
@@ -75,18 +85,35 @@ bool face_needs(const Garment& g, const Points& positions, std::size_t f, const 
   const Vec3 centre = face_centre(g, positions, f);
   double radius = 0.0;
   for (Index v : face) radius = std::max(radius, (row3(positions, v) - centre).norm());
-  const Constraint at_centre = check_vertex(centre, body, clearance);
-  if (at_centre.active) {
-    inside = at_centre.inside;
-    for (std::size_t i = 0; i < face.size(); ++i) ask(i, at_centre, 1.0);
-  } else if (!(body.closest_within(centre, radius + clearance).distance < radius + clearance)) {
+  const double margin = 1e-9 * (1.0 + centre.cwiseAbs().maxCoeff() + radius);  // rounding
+  const auto clear_by_a_corner = [&](const Vec3& q) {
+    if (!outside_by) return false;
+    for (Index v : face)
+      if ((*outside_by)[v] - (q - row3(positions, v)).norm() >= clearance + margin) return true;
     return false;
+  };
+  // The distance to the body changes no faster than the point moves: a sample
+  // closer to an outside centre than the centre's distance less the clearance
+  // clears the body too.
+  double clear_within = -1.0;
+  if (!clear_by_a_corner(centre)) {
+    const bool centre_in = body.inside(centre);
+    const ClosestPoint at = centre_in ? body.closest(centre) : body.closest_within(centre, radius + clearance);
+    if (!centre_in && !(at.distance < radius + clearance)) return false;
+    const Constraint at_centre = constraint_at(centre, centre_in, at, clearance);
+    if (at_centre.active) {
+      inside = at_centre.inside;
+      for (std::size_t i = 0; i < face.size(); ++i) ask(i, at_centre, 1.0);
+    }
+    if (!centre_in) clear_within = at.distance - clearance - margin;
   }
   const Vec3 a = row3(positions, face[0]);
   for (std::size_t k = 1; k + 1 < face.size(); ++k) {
     const Vec3 b = row3(positions, face[k]), c = row3(positions, face[k + 1]);
     for (const auto& w : kFaceSamples) {
-      const Constraint s = check_vertex(w[0] * a + w[1] * b + w[2] * c, body, clearance);
+      const Vec3 q = w[0] * a + w[1] * b + w[2] * c;
+      if ((q - centre).norm() <= clear_within || clear_by_a_corner(q)) continue;
+      const Constraint s = check_vertex(q, body, clearance);
       if (!s.active) continue;
       inside = inside || s.inside;
       const double norm2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
@@ -169,7 +196,7 @@ void unfold(const Garment& g, const Points& positions, const std::vector<Index>&
 bool face_inside(const Garment& g, const Points& positions, std::size_t f, const BodySurface& body) {
   if (g.faces.row_size(f) < 3) return false;
   std::vector<Constraint> need;
-  return face_needs(g, positions, f, body, 0.0, need);
+  return face_needs(g, positions, f, body, 0.0, nullptr, need);
 }
 
 }  // namespace
@@ -186,6 +213,10 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   std::vector<Index> to_check;  // empty in round 1: check everything
   std::vector<Index> touched;   // every vertex any round may have moved
   std::vector<int> ring(n, -1);
+  std::vector<long> slot(n, -1);
+  // Per vertex, how far it is known to be outside body B (this round's check, or
+  // an earlier one's for vertices not moved since): see face_needs.
+  std::vector<double> outside_by(n, 0.0);  // a region vertex's slot in this round's `region`, else -1
   std::vector<std::uint8_t> constrained(n, 0);  // this round's vertex constraints
   std::vector<std::uint8_t> finite(n, 0);
   parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
@@ -213,7 +244,11 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
         for (std::size_t k = blk * kBlock; k < std::min(count, (blk + 1) * kBlock); ++k) {
           const Index i = round == 0 ? static_cast<Index>(k) : to_check[k];
           if (!finite[i]) continue;
-          const Constraint c = check_vertex(row3(positions, i), body_b, options.clearance);
+          const Vec3 p = row3(positions, i);
+          const bool in = body_b.inside(p);
+          const ClosestPoint cp = in ? body_b.closest(p) : body_b.closest_within(p, options.clearance);
+          outside_by[i] = in ? 0.0 : std::min(cp.distance, options.clearance);
+          const Constraint c = constraint_at(p, in, cp, options.clearance);
           if (c.active) found[blk].emplace_back(i, c);
         }
     });
@@ -245,7 +280,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
             ok = ok && finite[v];
           }
           if (!check || !ok) continue;
-          const bool in = face_needs(g, positions, f, body_b, options.face_clearance, need);
+          const bool in = face_needs(g, positions, f, body_b, options.face_clearance, &outside_by, need);
           faces_in[blk] += in;
           if (round == 0) face_inside_before[f] = in;
           const bool last_round = round + 1 >= std::max(1, options.max_rounds);
@@ -308,10 +343,8 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     // the region count as fixed (zero), which gives the correction its falloff.
     const std::size_t m = region.size();
     std::vector<Vec3> disp(m, Vec3::Zero()), next(m);
-    auto slot_of = [&](Index v) -> long {
-      auto it = std::lower_bound(region.begin(), region.end(), v);
-      return (it != region.end() && *it == v) ? static_cast<long>(it - region.begin()) : -1L;
-    };
+    for (std::size_t k = 0; k < m; ++k) slot[region[k]] = static_cast<long>(k);
+    auto slot_of = [&](Index v) -> long { return slot[v]; };
     // Each region vertex's in-region neighbours, as slots of `region`.
     std::vector<std::vector<long>> rows(m);
     parallel_for(0, m, 256, [&](std::size_t b, std::size_t e) {
@@ -381,7 +414,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     parallel_for(0, m, 1024, [&](std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e; ++k) positions.row(region[k]) += disp[k].transpose();
     });
-    for (Index i : region) ring[i] = -1;
+    for (Index i : region) ring[i] = -1, slot[i] = -1;
     to_check = std::move(region);
   }
   // Anything still inside after the last round (reported, never hidden).
