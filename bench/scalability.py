@@ -1,10 +1,17 @@
 #!/usr/bin/env python3
-"""End-to-end scalability driver: runs `refit resize` (load to write) on procedural
-dresses of several sizes with 1 and 2 threads and prints a Markdown table of the
-report's stage timings (ms) and peak memory, median of --repeat runs.
+"""End-to-end scalability driver: runs `refit resize` (load to write) on dresses of
+several sizes with 1 and 2 threads and prints a Markdown table of the report's stage
+timings (ms), the process wall time and peak memory, median of --repeat runs.
 
     python3 bench/scalability.py [--refit build/release/tools/refit]
         [--sizes 100000 1000000 4000000] [--threads 1 2] [--stage warp|full] [--repeat 3]
+        [--garment procedural|dress|outfit] [--data ../shared/data]
+
+--garment procedural (default): the generated A-line dress and mannequins, with its
+generated features. --garment dress / outfit: the shared MakeHuman dress / dress over
+jeans densified by ../shared/data/make_dense.py to at least each size, body A_female to
+F_heavier, the quality suite's features (bench/quality/features/); exits 77 without the
+shared data.
 
 Runs alternate between the thread counts. After each size's rows, the ratio of
 the first thread count's median total to each other's.
@@ -16,6 +23,11 @@ import statistics
 import subprocess
 import sys
 import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REAL = {"dress": ("dress_on_A_female.obj", "dress.json"), "outfit": ("outfit_dress_jeans_on_A_female.obj",
+                                                                   "outfit_dress_jeans.json")}
 
 
 def run(cmd):
@@ -30,25 +42,39 @@ def main():
     ap.add_argument("--stage", default="full")
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--workdir", default=None)
+    ap.add_argument("--garment", default="procedural", choices=["procedural"] + sorted(REAL))
+    ap.add_argument("--data", default=os.path.join(HERE, "..", "..", "shared", "data"))
     a = ap.parse_args()
     work = a.workdir or tempfile.mkdtemp(prefix="refit-scal-")
     os.makedirs(work, exist_ok=True)
-    A, B = os.path.join(work, "A.obj"), os.path.join(work, "B.obj")
-    run([a.refit, "generate", "--body-out", A])
-    run([a.refit, "generate", "--belly", "6", "--hip", "104", "--waist", "76", "--bust", "92", "--body-out", B])
+    if a.garment == "procedural":
+        A, B = os.path.join(work, "A.obj"), os.path.join(work, "B.obj")
+        run([a.refit, "generate", "--body-out", A])
+        run([a.refit, "generate", "--belly", "6", "--hip", "104", "--waist", "76", "--bust", "92", "--body-out", B])
+    else:
+        if not os.path.isdir(os.path.join(a.data, "garments")):
+            print(f"skipped: the shared data is not at {a.data}")
+            return 77
+        A, B = (os.path.join(a.data, "bodies", b + ".obj") for b in ("A_female", "F_heavier"))
     stages = ["load", "bind", "warp", "features", "surface", "collision", "write", "total"]
-    print(f"stage: {a.stage}; medians of {a.repeat} runs; ms except memory")
-    print("| vertices | threads | " + " | ".join(stages) + " | peak MB | bytes/vertex |")
-    print("|" + "---:|" * (len(stages) + 4))
+    print(f"garment: {a.garment}; stage: {a.stage}; medians of {a.repeat} runs; ms except memory")
+    print("| vertices | threads | " + " | ".join(stages) + " | process wall | peak MB | bytes/vertex |")
+    print("|" + "---:|" * (len(stages) + 5))
     ratios = []
     for n in a.sizes:
-        g = os.path.join(work, f"dress_{n}.obj")
-        f = os.path.join(work, f"dress_{n}.json")
-        if not (os.path.exists(g) and os.path.exists(f)):  # a --workdir kept from an earlier run has them
+        g = os.path.join(work, f"{a.garment}_{n}.obj")
+        f = os.path.join(work, f"{a.garment}_{n}.json")
+        if a.garment != "procedural":
+            f = os.path.join(HERE, "quality", "features", REAL[a.garment][1])
+            if not os.path.exists(g):
+                run([sys.executable, os.path.join(a.data, "make_dense.py"), os.path.join(a.data, "garments", REAL[a.garment][0]),
+                     g, "--min-vertices", str(n)])
+        elif not (os.path.exists(g) and os.path.exists(f)):  # a --workdir kept from an earlier run has them
             run([a.refit, "generate", "--vertices", str(n), "--garment-out", g, "--features-out", f])
         # Thread counts take turns run by run, so a slow spell of the shared
         # machine hits them alike and their ratio stays meaningful.
         reports = {t: [] for t in a.threads}
+        walls = {t: [] for t in a.threads}
         for _ in range(a.repeat):
             for t in a.threads:
                 rep = os.path.join(work, "report.json")
@@ -56,7 +82,9 @@ def main():
                        "--report", rep, "--threads", str(t), "--quiet", "--stage", a.stage]
                 if a.stage != "warp":
                     cmd += ["--features", f]
+                start = time.monotonic()
                 run(cmd)
+                walls[t].append(time.monotonic() - start)
                 reports[t].append(json.load(open(rep)))
         for t in a.threads:
             rows = reports[t]
@@ -69,7 +97,8 @@ def main():
             verts = rows[0]["garment"]["vertices"]
             mem = statistics.median(r["peak_memory_mb"] for r in rows)
             cells = " | ".join(f"{med(s):.0f}" for s in stages)
-            print(f"| {verts} | {t} | {cells} | {mem:.0f} | {mem * 1048576 / verts:.0f} |", flush=True)
+            wall = statistics.median(walls[t])
+            print(f"| {verts} | {t} | {cells} | {wall:.2f} s | {mem:.0f} | {mem * 1048576 / verts:.0f} |", flush=True)
             totals = [r["timings_ms"]["total"] for r in rows]
             if t == a.threads[0]:
                 base = statistics.median(totals)
