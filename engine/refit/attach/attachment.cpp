@@ -181,6 +181,11 @@ class GarmentLocator::ElementIndex {
     auto* q = static_cast<Query*>(args->userPtr);
     const ElementIndex& self = *q->index;
     const std::size_t id = args->primID;
+    // The element's box first: farther than the best so far, the element cannot win.
+    const auto& v = self.elements_[id].v;
+    const Vec3 a = row3(self.x_, v[0]), b = row3(self.x_, v[1]), cc = row3(self.x_, v[2]);
+    const Vec3 lo = a.cwiseMin(b).cwiseMin(cc), hi = a.cwiseMax(b).cwiseMax(cc);
+    if ((q->p - q->p.cwiseMax(lo).cwiseMin(hi)).squaredNorm() > q->best.d2) return false;
     const Candidate c = closest_on_element(q->p, self.x_, self.elements_[id].v, self.elements_[id].corners);
     if (!(c.d2 < q->best.d2 || (c.d2 == q->best.d2 && id < q->best_id))) return false;
     q->best = c;
