@@ -2,6 +2,8 @@
 // garments side by side, feature curves on top.
 #include "command.hpp"
 
+#include <refit/io/atomic_file.hpp>
+
 #include <refit/core/error.hpp>
 #include <refit/io/body_io.hpp>
 #include <refit/io/obj_garment.hpp>
@@ -53,6 +55,10 @@ std::vector<Points> read_curves(const std::string& path) {
 
 int run(const RenderArgs& a) {
   const RenderOptions options = parse_options(a);
+  std::vector<std::string> inputs = {a.body, a.garment};
+  if (!a.garment2.empty()) inputs.push_back(a.garment2);
+  if (!a.curves.empty()) inputs.push_back(a.curves);
+  check_outputs(inputs, {a.out});  // before the work: a wrong --out fails at once
   const BodyMesh body = read_body(a.body);
   const Garment garment = read_garment_obj(a.garment);
   std::unique_ptr<Garment> second;

@@ -5,6 +5,7 @@
 
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
+#include <refit/io/atomic_file.hpp>
 #include <refit/io/body_io.hpp>
 #include <refit/io/obj_garment.hpp>
 #include <refit/features/curves_obj.hpp>
@@ -12,6 +13,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 
 namespace refit::cli {
 namespace {
@@ -38,6 +40,21 @@ std::string check_clearance(const std::string& s) {
   }
   if (!(v >= 0 && v <= 10)) return s + " is outside 0 to 10 cm";
   return {};
+}
+
+// Every file this run will write, in order: the garments (--out, or one per body
+// in --out-dir), then --curves-out and --report.
+std::vector<std::string> output_paths(const ResizeArgs& a) {
+  std::vector<std::string> outs;
+  if (!a.out_dir.empty()) {
+    for (const std::string& to : a.to)
+      outs.push_back((std::filesystem::path(a.out_dir) / (std::filesystem::path(to).stem().string() + ".obj")).string());
+  } else {
+    outs.push_back(a.out);
+  }
+  if (!a.curves_out.empty()) outs.push_back(a.curves_out);
+  if (!a.report.empty()) outs.push_back(a.report);
+  return outs;
 }
 
 Stage parse_stage(const std::string& s) {
@@ -82,6 +99,24 @@ int run(const ResizeArgs& a) {
   options.clearance_cm = a.clearance;
   if (!a.curves_out.empty() && a.features.empty()) throw Error("--curves-out needs --features");
   if (!a.curves_out.empty() && a.to.size() > 1) throw Error("--curves-out works with one --to body");
+  if (!a.out_dir.empty()) {
+    // --out-dir names each garment after its body's file: two bodies may not share a name.
+    for (std::size_t i = 0; i < a.to.size(); ++i)
+      for (std::size_t j = 0; j < i; ++j)
+        if (std::filesystem::path(a.to[i]).stem() == std::filesystem::path(a.to[j]).stem())
+          throw Error("--out-dir: bodies " + a.to[j] + " and " + a.to[i] + " would both write " +
+                      std::filesystem::path(a.to[i]).stem().string() + ".obj (rename one)");
+    std::error_code ec;
+    if (std::filesystem::exists(a.out_dir, ec) && !std::filesystem::is_directory(a.out_dir, ec))
+      throw input_error(a.out_dir, "--out-dir is not a folder");
+    std::filesystem::create_directories(a.out_dir, ec);
+    if (ec) throw input_error(a.out_dir, "cannot create the --out-dir folder: " + ec.message());
+  }
+  const std::vector<std::string> outs = output_paths(a);
+  std::vector<std::string> ins = {a.garment, a.from};
+  ins.insert(ins.end(), a.to.begin(), a.to.end());
+  if (!a.features.empty()) ins.push_back(a.features);
+  check_outputs(ins, outs);
 
   Stopwatch clock;
   progress.stage("reading " + a.garment);
@@ -93,12 +128,16 @@ int run(const ResizeArgs& a) {
   if (a.no_shape_control) options.stage = Stage::Warp;
   const GarmentBinding binding(garment, std::move(body_a), options, std::move(features), progress);
 
-  if (!a.out_dir.empty()) std::filesystem::create_directories(a.out_dir);
+  // One body: the OBJ, the curves and the report appear together or not at all.
+  // Several: each body's files appear when it is done.
+  std::optional<OutputBatch> all_outputs;
+  if (a.to.size() == 1) all_outputs.emplace();
   nlohmann::json reports = nlohmann::json::array();
   std::size_t failed = 0;
   for (const std::string& to : a.to) {
     Stopwatch body_clock;
     try {
+      OutputBatch body_outputs;
       clock.reset();
       const BodyMesh body_b = read_body(to);
       const double load_b_ms = clock.ms();
@@ -128,6 +167,7 @@ int run(const ResizeArgs& a) {
       r["peak_memory_mb"] = peak_memory_mb();
       r["warnings"] = result.warnings;
       reports.push_back(r);
+      body_outputs.commit();
       progress.stage("wrote " + out);
       total.reset();
     } catch (const Error& e) {
@@ -141,6 +181,7 @@ int run(const ResizeArgs& a) {
     nlohmann::json doc = reports.size() == 1 ? reports[0] : nlohmann::json{{"version", kVersion}, {"bodies", reports}};
     write_json_report(a.report, doc);
   }
+  if (all_outputs) all_outputs->commit();
   if (failed > 0) {
     std::fprintf(stderr, "refit: %zu of %zu bodies failed\n", failed, a.to.size());
     return 4;

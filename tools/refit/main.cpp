@@ -3,6 +3,7 @@
 #include "command.hpp"
 
 #include <refit/core/error.hpp>
+#include <refit/io/atomic_file.hpp>
 
 #include <algorithm>
 #include <cstdio>
@@ -34,6 +35,7 @@ int main(int argc, char** argv) {
     // --help/--version exit 0; every usage error exits 2 (not CLI11's own 104/105/...).
     return app.exit(e) == 0 ? 0 : 2;
   }
+  refit::remove_temporaries_on_signal();
   try {
     for (auto& [sub, action] : actions)
       if (sub->parsed()) return action();

@@ -1,12 +1,52 @@
 #pragma once
 // Output files appear whole or not at all: write to a temporary file beside the
 // target, then rename over it. On any exception the temporary is removed.
+//
+// What an output may replace (docs/cli-errors.md): a regular file, or through a
+// symbolic link the regular file it points to (the link stays); never a
+// directory, a device, a FIFO or a socket. The folder must exist.
+#include <filesystem>
 #include <functional>
+#include <memory>
 #include <ostream>
 #include <string>
 #include <vector>
 
 namespace refit {
+
+/// Where writing `path` puts the file (a symbolic link's final target); throws
+/// refit::Error naming `path` when it may not be written (see above).
+std::filesystem::path checked_output_path(const std::string& path);
+
+/// Before the work of a run: every output may be written (checked_output_path),
+/// no two outputs are the same file, and none is one of the inputs (after
+/// following symbolic links; hard links count too). Throws refit::Error naming
+/// the output and the file it would clobber.
+void check_outputs(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs);
+
+/// Outputs that appear together: while an OutputBatch lives on this thread, the
+/// writers below leave their temporary files in it instead of renaming them;
+/// commit() renames them all, and a batch destroyed without commit() removes
+/// them, so a failure part way leaves nothing new.
+class OutputBatch {
+ public:
+  OutputBatch();
+  ~OutputBatch();
+  OutputBatch(const OutputBatch&) = delete;
+  OutputBatch& operator=(const OutputBatch&) = delete;
+  void commit();
+
+ private:
+  friend void finish_output(const std::filesystem::path&, const std::filesystem::path&, const std::string&);
+  std::vector<std::pair<std::filesystem::path, std::filesystem::path>> staged_;  // temporary, target
+  std::vector<std::string> names_;                                                // as the user gave them
+  std::vector<int> slots_;  // held for the signal handler until renamed or removed
+  OutputBatch* outer_;
+};
+
+/// Temporaries are removed when SIGINT or SIGTERM ends the process (then the
+/// signal's default action runs). Call once, from main.
+void remove_temporaries_on_signal();
 
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
