@@ -1,5 +1,6 @@
 // The command line is a contract scripts depend on: outputs, reports, exit
 // codes, and bad input that leaves nothing behind.
+#include "cli/cli_case.hpp"
 #include "mannequin/mannequin.hpp"
 #include "support/test_support.hpp"
 
@@ -17,41 +18,9 @@ namespace refit {
 namespace {
 
 namespace fs = std::filesystem;
+using test::Case;
+using test::files_in;
 using test::run_cli;
-
-// A small procedural case written to files: bodies A and B (belly, hips), a dress
-// and its feature file.
-struct Case {
-  test::TempDir dir;
-  std::string a, b, garment, features;
-  Case(std::size_t vertices = 6000, bool two_layers = false) {
-    mannequin::BodyParams pa, pb;
-    pb.belly = 6;
-    pb.hip = 104;
-    mannequin::GarmentParams g;
-    g.target_vertices = vertices;
-    g.two_layers = two_layers;
-    a = dir.file("A.obj");
-    b = dir.file("B.obj");
-    garment = dir.file("dress.obj");
-    features = dir.file("features.json");
-    write_body_obj(a, mannequin::make_body(pa));
-    write_body_obj(b, mannequin::make_body(pb));
-    write_garment_obj(garment, mannequin::make_garment(pa, g));
-    test::write_text(features, mannequin::dress_features_json(pa, g));
-  }
-  std::string resize(const std::string& out, const std::string& extra = "") const {
-    return "resize --quiet --garment '" + garment + "' --from '" + a + "' --to '" + b + "' --out '" + out + "' " + extra;
-  }
-};
-
-// Only the named outputs may exist in the folder: no partial or temporary files.
-std::vector<std::string> files_in(const fs::path& dir) {
-  std::vector<std::string> names;
-  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
-}
 
 TEST(Cli, ResizeWritesOutputAndReport) {
   const Case c;
@@ -228,7 +197,10 @@ INSTANTIATE_TEST_SUITE_P(
                  "features", "spiral"},
         BadInput{"features_miss_garment",
                  R"({"units":"cm","features":[{"name":"far","plane":{"point":[0,0,5000],"normal":[0,0,1]},"curve":{"kind":"slice","near":[0,0,5000]},"samples":20}]})",
-                 "features", "far"}),
+                 "features", "far"},
+        BadInput{"features_bspline_far_in_its_plane",
+                 R"({"units":"cm","features":[{"name":"far","plane":{"point":[0,100,0],"normal":[0,1,0]},"curve":{"kind":"bspline","degree":3,"closed":false,"control_points":[[1000,100,0],[1010,100,0],[1020,100,0],[1030,100,5]]},"samples":20}]})",
+                 "features", "outside the garment's box"}),
     [](const auto& info) { return info.param.name; });
 
 TEST(Cli, UsageErrorsExitTwoAndHelpDocumentsExitCodes) {

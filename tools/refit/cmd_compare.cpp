@@ -5,6 +5,7 @@
 
 #include <refit/core/error.hpp>
 #include <refit/features/feature_file.hpp>
+#include <refit/io/atomic_file.hpp>
 #include <refit/io/body_io.hpp>
 #include <refit/io/obj_garment.hpp>
 #include <refit/metrics/metrics.hpp>
@@ -21,6 +22,7 @@ struct CompareArgs {
 };
 
 int run(const CompareArgs& a) {
+  if (!a.report.empty()) check_outputs({a.garment, a.from, a.to, a.result, a.features}, {a.report});  // before the work
   const Garment garment = read_garment_obj(a.garment);
   const Garment result = read_garment_obj(a.result);
   if (result.positions.rows() != garment.positions.rows())

@@ -39,8 +39,15 @@ int run(const DemoArgs& a) {
   ThreadLimit limit(a.threads);
   const Progress progress(a.quiet);
   namespace fs = std::filesystem;
-  fs::create_directories(a.out_dir);
+  // The files appear one by one (the demo reads back what it wrote, as `refit
+  // resize` would); each is checked before the work.
+  OutputFolder folder(a.out_dir);
   const auto path = [&](const std::string& name) { return (fs::path(a.out_dir) / name).string(); };
+  std::vector<std::string> outs;
+  for (const char* name : {"body_A.obj", "body_B.obj", "dress_on_A.obj", "dress_features.json", "dress_on_B_warp_only.obj",
+                           "dress_on_B.obj", "dress_curves.obj", "report.json", "before_after.png", "design_on_A.png"})
+    outs.push_back(path(name));
+  check_outputs({}, outs);
 
   progress.stage("generating the mannequins and the dress");
   const mannequin::BodyParams body_a;
@@ -94,6 +101,7 @@ int run(const DemoArgs& a) {
   views.title = "the design on body_A";
   write_png(path("design_on_A.png"), render(binding.body_a().mesh(), *garment, nullptr, {}, views));
 
+  folder.keep();
   std::printf("refit demo: dress of %zu vertices resized from body_A to body_B (belly %+g cm, hip %g cm)\n",
               garment->vertex_count(), a.body_b.belly, a.body_b.hip);
   std::printf("  %-16s %14s %14s %14s\n", "feature", "error (warp)", "error (curve)", "error (output)");

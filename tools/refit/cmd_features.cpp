@@ -7,6 +7,7 @@
 #include <refit/features/curves_obj.hpp>
 #include <refit/features/feature_curves.hpp>
 #include <refit/features/feature_file.hpp>
+#include <refit/io/atomic_file.hpp>
 #include <refit/io/obj_garment.hpp>
 
 #include <cstdio>
@@ -28,6 +29,7 @@ const refit::cli::Register reg(
       app.add_option("--out", opt->out, "Output OBJ with one polyline per feature")->required();
       app.add_option("--units", opt->units, "Units of the garment: cm, mm, m or in")->capture_default_str();
       return [opt]() -> int {
+        refit::check_outputs({opt->garment, opt->features}, {opt->out});  // before the work
         // Parse the feature file first: its errors need no garment.
         const auto specs = refit::read_feature_file(opt->features, opt->units);
         const refit::Garment g = refit::read_garment_obj(opt->garment);

@@ -36,12 +36,18 @@ int run(const GenerateArgs& a) {
   g.ease = a.ease;
   g.soup = a.soup;
   g.two_layers = a.two_layers;
+  std::vector<std::string> outs;
+  for (const std::string* out : {&a.body_out, &a.garment_out, &a.features_out})
+    if (!out->empty()) outs.push_back(*out);
+  check_outputs({}, outs);
+  OutputBatch together;
   if (!a.body_out.empty()) write_body_obj(a.body_out, mannequin::make_body(a.body));
   if (!a.garment_out.empty()) write_garment_obj(a.garment_out, mannequin::make_garment(a.body, g));
   if (!a.features_out.empty()) {
     const std::string json = mannequin::dress_features_json(a.body, g);
     write_file_atomically(a.features_out, [&](std::ostream& out) { out << json; });
   }
+  together.commit();
   return 0;
 }
 

@@ -9,7 +9,9 @@
 #include <refit/io/body_io.hpp>
 #include <refit/io/obj_garment.hpp>
 #include <refit/features/curves_obj.hpp>
+#include <refit/pipeline/input_checks.hpp>
 #include <refit/pipeline/resize.hpp>
+#include <refit/pipeline/units.hpp>
 
 #include <cstdio>
 #include <filesystem>
@@ -106,12 +108,11 @@ int run(const ResizeArgs& a) {
         if (std::filesystem::path(a.to[i]).stem() == std::filesystem::path(a.to[j]).stem())
           throw Error("--out-dir: bodies " + a.to[j] + " and " + a.to[i] + " would both write " +
                       std::filesystem::path(a.to[i]).stem().string() + ".obj (rename one)");
-    std::error_code ec;
-    if (std::filesystem::exists(a.out_dir, ec) && !std::filesystem::is_directory(a.out_dir, ec))
-      throw input_error(a.out_dir, "--out-dir is not a folder");
-    std::filesystem::create_directories(a.out_dir, ec);
-    if (ec) throw input_error(a.out_dir, "cannot create the --out-dir folder: " + ec.message());
   }
+  // Every output is checked before the work; a folder made for the run goes
+  // again if the run fails.
+  std::optional<OutputFolder> folder;
+  if (!a.out_dir.empty()) folder.emplace(a.out_dir);
   const std::vector<std::string> outs = output_paths(a);
   std::vector<std::string> ins = {a.garment, a.from};
   ins.insert(ins.end(), a.to.begin(), a.to.end());
@@ -122,27 +123,29 @@ int run(const ResizeArgs& a) {
   progress.stage("reading " + a.garment);
   auto garment = std::make_shared<const Garment>(read_garment_obj(a.garment));
   BodyMesh body_a = read_body(a.from);
+  check_human_size(body_a, units_per_cm(a.units));
   const double load_ms = clock.ms();
+  const std::vector<std::string> garment_warnings = garment->source ? garment->source->warnings : std::vector<std::string>{};
+  for (const auto& w : garment_warnings) std::fprintf(stderr, "refit: warning: %s\n", w.c_str());
   std::vector<FeatureSpec> features;
   if (!a.features.empty()) features = read_feature_file(a.features, a.units);
   if (a.no_shape_control) options.stage = Stage::Warp;
   const GarmentBinding binding(garment, std::move(body_a), options, std::move(features), progress);
 
-  // One body: the OBJ, the curves and the report appear together or not at all.
-  // Several: each body's files appear when it is done.
-  std::optional<OutputBatch> all_outputs;
-  if (a.to.size() == 1) all_outputs.emplace();
+  // Every output of the run appears together at its end, or none (a body that
+  // fails in a batch is skipped: its files never appear).
+  OutputBatch all_outputs;
   nlohmann::json reports = nlohmann::json::array();
   std::size_t failed = 0;
-  for (const std::string& to : a.to) {
-    Stopwatch body_clock;
+  for (std::size_t body = 0; body < a.to.size(); ++body) {
+    const std::string& to = a.to[body];
+    const std::string& out = outs[body];
     try {
       OutputBatch body_outputs;
       clock.reset();
       const BodyMesh body_b = read_body(to);
       const double load_b_ms = clock.ms();
       ResizeResult result = binding.resize(body_b, progress);
-      const std::string out = a.out_dir.empty() ? a.out : (std::filesystem::path(a.out_dir) / (body_b.name + ".obj")).string();
       clock.reset();
       progress.stage("writing " + out);
       const ObjWriteReport written = write_garment_obj(out, *garment, result.positions);
@@ -152,11 +155,15 @@ int run(const ResizeArgs& a) {
       r["timings_ms"]["load"] = load_ms + load_b_ms;
       r["timings_ms"]["bind"] = binding.bind_report();
       r["timings_ms"]["total"] = total.ms();
-      for (const auto& w : written.warnings) result.warnings.push_back(w);
-      if (written.normals_recomputed > 0)
-        result.warnings.push_back(std::to_string(written.normals_recomputed) + " vn normals recomputed from the new positions");
-      for (const auto& w : garment->source ? garment->source->warnings : std::vector<std::string>{})
+      // On stderr too (not only in the report), naming the body or the output.
+      for (const auto& w : result.warnings) std::fprintf(stderr, "refit: warning: %s: %s\n", to.c_str(), w.c_str());
+      for (const auto& w : written.warnings) {
+        std::fprintf(stderr, "refit: warning: %s: %s\n", out.c_str(), w.c_str());
         result.warnings.push_back(w);
+      }
+      if (written.normals_recomputed > 0)  // what the writer always does: the report says how many
+        result.warnings.push_back(std::to_string(written.normals_recomputed) + " vn normals recomputed from the new positions");
+      for (const auto& w : garment_warnings) result.warnings.push_back(w);
       r["version"] = kVersion;
       r["garment"] = garment_summary(*garment);
       r["garment"]["file"] = a.garment;
@@ -168,7 +175,7 @@ int run(const ResizeArgs& a) {
       r["warnings"] = result.warnings;
       reports.push_back(r);
       body_outputs.commit();
-      progress.stage("wrote " + out);
+      progress.stage("done " + out);
       total.reset();
     } catch (const Error& e) {
       if (a.to.size() == 1) throw;
@@ -181,7 +188,8 @@ int run(const ResizeArgs& a) {
     nlohmann::json doc = reports.size() == 1 ? reports[0] : nlohmann::json{{"version", kVersion}, {"bodies", reports}};
     write_json_report(a.report, doc);
   }
-  if (all_outputs) all_outputs->commit();
+  all_outputs.commit();
+  if (folder) folder->keep();
   if (failed > 0) {
     std::fprintf(stderr, "refit: %zu of %zu bodies failed\n", failed, a.to.size());
     return 4;

@@ -22,6 +22,10 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "refit 0.1.0");
   app.footer("Exit codes: 0 ok, 1 bad input, 2 usage, 3 out of resources, 4 some bodies of a batch failed.");
+  // A usage error is one line like every other error (not CLI11's two).
+  app.failure_message([](const CLI::App*, const CLI::Error& e) {
+    return std::string("refit: error: ") + e.what() + " (see --help)\n";
+  });
   auto& commands = registry();
   std::sort(commands.begin(), commands.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
   std::vector<std::pair<CLI::App*, std::function<int()>>> actions;
@@ -39,6 +43,9 @@ int main(int argc, char** argv) {
   try {
     for (auto& [sub, action] : actions)
       if (sub->parsed()) return action();
+  } catch (const refit::ResourceError& e) {
+    std::fprintf(stderr, "refit: error: %s\n", e.what());
+    return 3;
   } catch (const refit::Error& e) {
     std::fprintf(stderr, "refit: error: %s\n", e.what());
     return 1;

@@ -12,6 +12,13 @@ class Error : public std::runtime_error {
   explicit Error(const std::string& message) : std::runtime_error(message) {}
 };
 
+/// Input this machine cannot afford (an estimate above the memory there is):
+/// the command line exits 3, not 1.
+class ResourceError : public Error {
+ public:
+  using Error::Error;
+};
+
 /// "file: problem" or "file:line: problem".
 inline Error input_error(const std::string& file, const std::string& problem, std::size_t line = 0) {
   std::string where = file.empty() ? std::string("<input>") : file;

@@ -31,4 +31,7 @@ class Stopwatch {
 /// Peak resident set size of this process in MB (VmHWM), 0 if unknown.
 double peak_memory_mb();
 
+/// This machine's memory in MB (physical pages), 0 if unknown.
+double physical_memory_mb();
+
 }  // namespace refit

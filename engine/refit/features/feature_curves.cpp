@@ -95,6 +95,18 @@ Points sub_polyline(const Points& poly, bool closed, PolylinePoint a, PolylinePo
   return out;
 }
 
+// A drawn curve whose plane crosses the garment may still lie far from it (a
+// B-spline 1000 cm away was silently ignored, issue 17): its farthest sample
+// from the garment's box may be at most `limit` away.
+void check_near_garment(const Garment& g, const FeatureSpec& s, const Points& samples, double limit) {
+  const Eigen::RowVector3d lo = g.positions.colwise().minCoeff(), hi = g.positions.colwise().maxCoeff();
+  double farthest = 0.0;
+  for (Eigen::Index k = 0; k < samples.rows(); ++k)
+    farthest = std::max(farthest, (samples.row(k).cwiseMax(lo).cwiseMin(hi) - samples.row(k)).norm());
+  if (farthest > limit)
+    fail(s, "the curve lies up to " + fmt(farthest) + " units outside the garment's box (more than " + fmt(limit) + ")");
+}
+
 FeatureCurve build_slice(const Garment& g, const FeatureSpec& s, double diag, const FeatureCurveOptions& o,
                          std::uint64_t stream) {
   const SliceResult cut = slice_garment(g, *s.plane, 1e-6 * diag);  // the default tolerance, diagonal known
@@ -270,7 +282,9 @@ std::vector<FeatureCurve> build_feature_curves(const Garment& g, const std::vect
           spline.control.resize(s.control_points.rows(), 3);
           for (Eigen::Index k = 0; k < s.control_points.rows(); ++k)
             spline.control.row(k) = s.plane->project(row3(s.control_points, static_cast<Index>(k))).transpose();
-          out.push_back(make_feature_curve(s.name, sample_by_arc_length(spline, s.samples), s.closed, *s.plane, o, i));
+          Points samples = sample_by_arc_length(spline, s.samples);
+          check_near_garment(g, s, samples, o.near_fraction * diag);
+          out.push_back(make_feature_curve(s.name, std::move(samples), s.closed, *s.plane, o, i));
           break;
         }
         case CurveKind::slice: out.push_back(build_slice(g, s, diag, o, i)); break;

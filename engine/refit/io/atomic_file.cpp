@@ -13,78 +13,91 @@
 #include <fcntl.h>
 #include <filesystem>
 #include <fstream>
-#include <mutex>
 #include <sys/stat.h>
 #include <unistd.h>
 
 namespace refit {
 
-namespace {
-
 namespace fs = std::filesystem;
 
-// Temporaries alive now, for the signal handler: fixed slots of plain chars, so
-// that the handler reads them without locks or allocation.
-constexpr std::size_t kSlots = 64, kPathMax = 4096;
-std::array<std::array<char, kPathMax>, kSlots> g_temporary{};
-std::array<std::atomic<bool>, kSlots> g_used{};
-std::mutex g_slot_mutex;
+namespace {
 
-int hold_temporary(const fs::path& tmp) {
-  const std::string s = tmp.string();
-  if (s.size() >= kPathMax) return -1;
-  const std::lock_guard<std::mutex> lock(g_slot_mutex);
-  for (std::size_t i = 0; i < kSlots; ++i)
-    if (!g_used[i].load()) {
-      std::memcpy(g_temporary[i].data(), s.c_str(), s.size() + 1);
-      g_used[i].store(true);
-      return int(i);
-    }
+// Temporaries alive now, for the signal handler: slots of C strings owned by
+// their TemporaryFile, so that the handler reads them without locks or allocation.
+constexpr std::size_t kSlots = 4096;
+std::array<std::atomic<const char*>, kSlots> g_temporary{};
+
+int hold_temporary(const char* path) {
+  for (std::size_t i = 0; i < kSlots; ++i) {
+    const char* expected = nullptr;
+    if (g_temporary[i].compare_exchange_strong(expected, path)) return int(i);
+  }
   return -1;  // more than kSlots at once: that one is not removed on a signal
 }
 
-void release_temporary(int slot) {
-  if (slot >= 0) g_used[std::size_t(slot)].store(false);
-}
-
 extern "C" void remove_temporaries_and_die(int sig) {
-  for (std::size_t i = 0; i < kSlots; ++i)
-    if (g_used[i].load()) ::unlink(g_temporary[i].data());
+  for (auto& slot : g_temporary)
+    if (const char* path = slot.load()) ::unlink(path);
   std::signal(sig, SIG_DFL);
   std::raise(sig);
 }
 
 thread_local OutputBatch* g_batch = nullptr;
+std::atomic<unsigned> g_temporary_count{0};
 
-// The temporary, held for the signal handler while it lives.
-class Temporary {
- public:
-  explicit Temporary(const fs::path& target)
-      : path_(target.parent_path() / ("." + target.filename().string() + ".tmp" + std::to_string(::getpid()))),
-        slot_(hold_temporary(path_)) {}
-  ~Temporary() {
-    if (!kept_) {
-      std::error_code ignore;
-      fs::remove(path_, ignore);
-    }
-    release_temporary(slot_);
-  }
-  const fs::path& path() const { return path_; }
-  void keep() { kept_ = true; }
-
- private:
-  fs::path path_;
-  int slot_;
-  bool kept_ = false;
-};
-
-void rename_or_throw(const fs::path& tmp, const fs::path& target, const std::string& path) {
-  std::error_code ec;
-  fs::rename(tmp, target, ec);
-  if (ec) throw input_error(path, "cannot rename temporary file: " + ec.message());
+// ".out.obj.<pid>.<n>.tmp" beside out.obj: hidden, and unique per process and call.
+fs::path temporary_name(const fs::path& target) {
+  std::string name = ".";  // not "." + string: GCC 12's false -Wrestrict (bug 105329)
+  name += target.filename().string();
+  name += '.';
+  name += std::to_string(::getpid());
+  name += '.';
+  name += std::to_string(g_temporary_count.fetch_add(1));
+  name += ".tmp";
+  return target.parent_path() / name;
 }
 
 }  // namespace
+
+namespace detail {
+
+// A temporary file beside its target, held for the signal handler while it
+// exists; removed by the destructor unless renamed over the target.
+class TemporaryFile {
+ public:
+  TemporaryFile(fs::path target, std::string name)
+      : target_(std::move(target)), name_(std::move(name)), path_(temporary_name(target_)),
+        slot_(hold_temporary(path_.c_str())) {}
+  ~TemporaryFile() {
+    if (!renamed_) {
+      std::error_code ignore;
+      fs::remove(path_, ignore);
+    }
+    if (slot_ >= 0) g_temporary[std::size_t(slot_)].store(nullptr);
+  }
+  TemporaryFile(const TemporaryFile&) = delete;
+  TemporaryFile& operator=(const TemporaryFile&) = delete;
+  const fs::path& path() const { return path_; }
+  const std::string& name() const { return name_; }
+
+  void rename_over_target() {
+    std::error_code ec;
+    fs::rename(path_, target_, ec);
+    if (ec) throw input_error(name_, "cannot rename temporary file: " + ec.message());
+    renamed_ = true;
+  }
+
+ private:
+  fs::path target_;
+  std::string name_;  // as the user gave it
+  fs::path path_;
+  int slot_;
+  bool renamed_ = false;
+};
+
+}  // namespace detail
+
+using detail::TemporaryFile;
 
 fs::path checked_output_path(const std::string& path) {
   if (path.empty()) throw Error("an output path is empty");
@@ -121,7 +134,8 @@ void check_outputs(const std::vector<std::string>& inputs, const std::vector<std
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     const fs::path target = checked_output_path(outputs[i]);
     for (const std::string& in : inputs)
-      if (same(target, in)) throw input_error(outputs[i], "is an input of this run (" + in + "): not overwritten");
+      if (!in.empty() && same(target, in))
+        throw input_error(outputs[i], "is an input of this run (" + in + "): not overwritten");
     for (std::size_t j = 0; j < seen.size(); ++j)
       if (same(target, seen[j]))
         throw input_error(outputs[i], "is also the output " + outputs[j] + ": each output needs its own file");
@@ -129,48 +143,69 @@ void check_outputs(const std::vector<std::string>& inputs, const std::vector<std
   }
 }
 
-// Renames the written temporary over the target, or leaves it to the batch.
-void finish_output(const fs::path& tmp, const fs::path& target, const std::string& path) {
-  if (g_batch) {
-    g_batch->staged_.emplace_back(tmp, target);
-    g_batch->names_.push_back(path);
-    g_batch->slots_.push_back(hold_temporary(tmp));
-    return;
-  }
-  rename_or_throw(tmp, target, path);
+// Renames the written temporary over its target, or leaves it to the batch.
+void finish_output(std::unique_ptr<TemporaryFile> temporary) {
+  if (g_batch)
+    g_batch->staged_.push_back(std::move(temporary));
+  else
+    temporary->rename_over_target();
 }
 
 OutputBatch::OutputBatch() : outer_(g_batch) { g_batch = this; }
 
 OutputBatch::~OutputBatch() {
   if (g_batch == this) g_batch = outer_;
-  for (const auto& [tmp, target] : staged_) {
-    std::error_code ignore;
-    fs::remove(tmp, ignore);
-  }
-  for (int slot : slots_) release_temporary(slot);
+  staged_.clear();  // removes the temporaries not renamed
 }
 
 void OutputBatch::commit() {
   if (g_batch == this) g_batch = outer_;
   // Into the enclosing batch if there is one. A rename that fails (the folder
   // vanished) throws, and the destructor removes the rest.
-  for (std::size_t i = 0; i < staged_.size(); ++i) finish_output(staged_[i].first, staged_[i].second, names_[i]);
+  for (auto& temporary : staged_) finish_output(std::move(temporary));
   staged_.clear();
 }
 
+OutputFolder::OutputFolder(const std::string& path) {
+  std::error_code ec;
+  const fs::path folder(path);
+  if (fs::exists(folder, ec)) {
+    if (!fs::is_directory(folder, ec)) throw input_error(path, "is not a folder");
+    return;
+  }
+  for (fs::path p = folder; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
+    created_.push_back(p);
+    if (p == p.parent_path()) break;
+  }
+  fs::create_directories(folder, ec);
+  if (ec) {
+    remove_created();  // what was made of the chain goes again
+    throw input_error(path, "cannot create the folder: " + ec.message());
+  }
+}
+
+void OutputFolder::remove_created() {
+  for (const fs::path& p : created_) {
+    std::error_code ignore;
+    fs::remove(p, ignore);  // only an empty folder goes
+  }
+  created_.clear();
+}
+
 void remove_temporaries_on_signal() {
-  struct sigaction sa {};
-  sa.sa_handler = remove_temporaries_and_die;
-  sigemptyset(&sa.sa_mask);
-  ::sigaction(SIGINT, &sa, nullptr);
-  ::sigaction(SIGTERM, &sa, nullptr);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction old {};
+    if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;  // nohup, `&` in a script
+    struct sigaction sa {};
+    sa.sa_handler = remove_temporaries_and_die;
+    sigemptyset(&sa.sa_mask);
+    ::sigaction(sig, &sa, nullptr);
+  }
 }
 
 void write_parts_atomically(const std::string& path, std::size_t count, const PartFormatter& format) {
-  const fs::path target = checked_output_path(path);
-  Temporary temporary(target);
-  const fs::path& tmp = temporary.path();
+  auto temporary = std::make_unique<TemporaryFile>(checked_output_path(path), path);
+  const fs::path& tmp = temporary->path();
   int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw input_error(path, std::string("cannot open for writing: ") + std::strerror(errno));
   try {
@@ -202,26 +237,23 @@ void write_parts_atomically(const std::string& path, std::size_t count, const Pa
     const int closed = ::close(fd);
     fd = -1;
     if (closed != 0) throw input_error(path, std::string("write failed: ") + std::strerror(errno));
-    finish_output(tmp, target, path);
-    temporary.keep();
   } catch (...) {
     if (fd >= 0) ::close(fd);
     throw;
   }
+  finish_output(std::move(temporary));
 }
 
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
-  const fs::path target = checked_output_path(path);
-  Temporary temporary(target);
+  auto temporary = std::make_unique<TemporaryFile>(checked_output_path(path), path);
   {
-    std::ofstream out(temporary.path(), std::ios::binary | std::ios::trunc);
+    std::ofstream out(temporary->path(), std::ios::binary | std::ios::trunc);
     if (!out) throw input_error(path, std::string("cannot open for writing: ") + std::strerror(errno));
     write(out);
     out.flush();
     if (!out) throw input_error(path, "write failed (disk full?)");
   }
-  finish_output(temporary.path(), target, path);
-  temporary.keep();
+  finish_output(std::move(temporary));
 }
 
 }  // namespace refit

@@ -24,10 +24,14 @@ std::filesystem::path checked_output_path(const std::string& path);
 /// the output and the file it would clobber.
 void check_outputs(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs);
 
+namespace detail {
+class TemporaryFile;
+}
+
 /// Outputs that appear together: while an OutputBatch lives on this thread, the
 /// writers below leave their temporary files in it instead of renaming them;
-/// commit() renames them all, and a batch destroyed without commit() removes
-/// them, so a failure part way leaves nothing new.
+/// commit() renames them all (or hands them to the enclosing batch), and a batch
+/// destroyed without commit() removes them, so a failure part way leaves nothing new.
 class OutputBatch {
  public:
   OutputBatch();
@@ -37,15 +41,31 @@ class OutputBatch {
   void commit();
 
  private:
-  friend void finish_output(const std::filesystem::path&, const std::filesystem::path&, const std::string&);
-  std::vector<std::pair<std::filesystem::path, std::filesystem::path>> staged_;  // temporary, target
-  std::vector<std::string> names_;                                                // as the user gave them
-  std::vector<int> slots_;  // held for the signal handler until renamed or removed
+  friend void finish_output(std::unique_ptr<detail::TemporaryFile>);
+  std::vector<std::unique_ptr<detail::TemporaryFile>> staged_;
   OutputBatch* outer_;
 };
 
-/// Temporaries are removed when SIGINT or SIGTERM ends the process (then the
-/// signal's default action runs). Call once, from main.
+/// An output folder made for a run (with the missing folders above it): unless
+/// keep() is called, the destructor removes those of them that are still empty,
+/// so a run that fails leaves no new folder either. Throws refit::Error naming
+/// `path` when it exists and is not a folder, or cannot be made.
+class OutputFolder {
+ public:
+  explicit OutputFolder(const std::string& path);
+  ~OutputFolder() { remove_created(); }
+  OutputFolder(const OutputFolder&) = delete;
+  OutputFolder& operator=(const OutputFolder&) = delete;
+  void keep() { created_.clear(); }
+
+ private:
+  void remove_created();
+  std::vector<std::filesystem::path> created_;  // innermost first
+};
+
+/// Temporaries are removed when SIGINT, SIGTERM or SIGHUP ends the process (then
+/// the signal's default action runs); a signal the process was started ignoring
+/// stays ignored. Call once, from main.
 void remove_temporaries_on_signal();
 
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write);

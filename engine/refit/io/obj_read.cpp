@@ -101,6 +101,12 @@ struct Sink {
   std::vector<ObjSource::Span>& nspans;
 };
 
+// A UTF-8 byte-order mark before the file's first statement is not part of it
+// (issue 17: it hid the first `v` line and shifted every face index).
+const char* skip_byte_order_mark(const char* b, const char* e, const char* file_start) {
+  return b == file_start && e - b >= 3 && std::memcmp(b, "\xEF\xBB\xBF", 3) == 0 ? b + 3 : b;
+}
+
 class ChunkParser {
  public:
   ChunkParser(std::string_view text, Chunk& out, const Sink& sink, Totals before, Totals totals)
@@ -113,7 +119,7 @@ class ChunkParser {
     try {
       for_each_line(base + begin, base + end, [&](const char* b, const char* e) {
         ++line_;
-        statement(b, e);
+        statement(skip_byte_order_mark(b, e, base), e);
       });
     } catch (const ParseFailure& f) {
       out_.failure = f;
@@ -293,6 +299,7 @@ class ChunkParser {
 void count_chunk(std::string_view text, std::size_t begin, std::size_t end, Chunk& c) {
   for_each_line(text.data() + begin, text.data() + end, [&](const char* b, const char* e) {
     ++c.lines;
+    b = skip_byte_order_mark(b, e, text.data());
     while (b < e && is_blank(*b)) ++b;
     if (e - b < 2) return;
     if (*b == 'f' && is_blank(b[1])) ++c.nf;

@@ -3,10 +3,13 @@
 #include <refit/features/curve_metrics.hpp>
 #include <refit/features/feature_curves.hpp>
 #include <refit/collision/collision.hpp>
+#include <refit/io/obj_garment.hpp>
 #include <refit/metrics/metrics.hpp>
 #include <refit/pipeline/resize.hpp>
+#include <refit/pipeline/input_checks.hpp>
 #include <refit/pipeline/units.hpp>
 
+#include <cstdio>
 #include <limits>
 #include <optional>
 
@@ -109,6 +112,8 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
   const double per_cm = units_per_cm(options_.units);
   if (garment_->vertex_count() == 0) throw Error("garment: empty garment (no vertices)");
   if (!garment_->positions.allFinite()) throw Error("garment: a vertex position is NaN or infinite");
+  check_garment_on_body_a(*garment_, body_a_.mesh(), per_cm);
+  check_memory_estimate();
 
   Stopwatch clock;
   progress.stage("binding " + std::to_string(garment_->vertex_count()) + " garment vertices to " + body_a_.mesh().name);
@@ -179,8 +184,34 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
     // One pass over the garment for every curve's samples; the surface binding
     // and the report's shape_error_output share it.
     if (all.rows() > 0) feature_attachment_ = locate().attach(all);
-    surface_ = SurfaceBinding::bind(*garment_, all, so, all.rows() > 0 ? &feature_attachment_ : nullptr);
+    try {
+      surface_ = SurfaceBinding::bind(*garment_, all, so, all.rows() > 0 ? &feature_attachment_ : nullptr);
+    } catch (const Error& e) {  // e.g. a voxel size too small for the garment: name its file
+      throw input_error(garment_->source ? garment_->source->file : "garment", e.what());
+    }
     bind_report_["surface"] = clock.ms();
+  }
+}
+
+// What a run will need, from the sizes alone (issue 17): refused before the work
+// when above the budget or this machine's memory, and given in the report.
+void GarmentBinding::check_memory_estimate() {
+  SurfaceOptions so = options_.surface;
+  so.voxel *= units_per_cm(options_.units);
+  double agents = 0.0;
+  try {
+    if (options_.stage == Stage::Full) agents = estimated_agent_count(*garment_, so);
+  } catch (const Error& e) {  // a voxel size too small for the garment: name its file
+    throw input_error(garment_->source ? garment_->source->file : "garment", e.what());
+  }
+  const double mb = estimated_memory_mb(garment_->vertex_count(), agents, body_a_.mesh().triangles.size());
+  memory_estimate_mb_ = mb;
+  const double budget = options_.memory_budget_mb > 0 ? options_.memory_budget_mb : physical_memory_mb();
+  if (budget > 0 && mb > budget) {
+    char text[200];
+    std::snprintf(text, sizeof text, "a resize of %zu vertices and about %.3g agents needs an estimated %.0f MB, more than the %.0f MB %s",
+                  garment_->vertex_count(), agents, mb, budget, options_.memory_budget_mb > 0 ? "of the memory budget" : "of this machine");
+    throw ResourceError((garment_->source ? garment_->source->file : std::string("garment")) + ": " + text);
   }
 }
 
@@ -189,12 +220,14 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
   check_same_connectivity(body_a_.mesh(), body_b);
   ResizeResult result;
   nlohmann::json& report = result.report;
+  report["memory_estimate_mb"] = memory_estimate_mb_;
   nlohmann::json& timings = report["timings_ms"];
   Stopwatch clock;
 
   // Step 1: primary resizing (section 3).
   progress.stage("warping to " + body_b.name);
   const TriangleFrames frames_b = compute_frames(body_b);
+  check_body_b_scale(body_a_.mesh(), body_b, frames_b);
   result.warped = warp_.apply(frames_b);
   timings["warp"] = clock.ms();
   report["warp"] = {{"alpha", options_.warp.alpha},
@@ -208,6 +241,14 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
   if (!result.warped.allFinite()) throw Error("internal: the warp produced a non-finite position");
   result.positions = result.warped;
   if (options_.stage == Stage::Warp) return result;
+  // Body B is body A wherever the garment is bound, so the warp kept every vertex
+  // to the bit: the garment as given is the answer. The later steps only correct
+  // what the warp changes, and the collision step moves nothing the input on A
+  // had as it is (docs/method.md, "Identity").
+  if ((result.warped.array() == garment_->positions.array()).all()) {
+    report["unchanged"] = true;
+    return result;
+  }
 
   clock.reset();
   const BodySurface surface_b(body_b);

@@ -36,6 +36,7 @@ struct ResizeOptions {
   bool collision = true;       // push vertices inside body B out (beyond the paper)
   double clearance_cm = 0.2;   // ... to this distance outside the body
   bool metrics = false;        // add fit, penetration and sanity metrics (warp and result) to the report
+  double memory_budget_mb = 0; // a run estimated above this is refused before the work (0: the machine's memory)
 };
 
 struct ResizeResult {
@@ -66,6 +67,7 @@ class GarmentBinding {
   const nlohmann::json& bind_report() const { return bind_report_; }
 
  private:
+  void check_memory_estimate();
   std::shared_ptr<const Garment> garment_;
   ResizeOptions options_;
   nlohmann::json symmetry_report_;
@@ -80,6 +82,7 @@ class GarmentBinding {
   std::optional<SurfaceBinding> surface_;
   SurfaceAttachment feature_attachment_;  // where the feature samples (all curves, in order) sit on the garment
   nlohmann::json bind_report_;
+  double memory_estimate_mb_ = 0.0;
 };
 
 /// The report's fixed part: garment counts.

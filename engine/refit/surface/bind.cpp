@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 
 namespace refit {
@@ -47,9 +48,34 @@ double surface_voxel(const Garment& g, const SurfaceOptions& options) {
   return auto_voxel_size(g, std::min(options.agent_budget, std::max<std::size_t>(g.vertex_count(), 1000)));
 }
 
+// A voxel size far below the garment's detail makes billions of agents (--voxel
+// 0.01 grew past 21 GB, issue 17): refused before anything is allocated.
+double agents_for_voxel(const Garment& g, double h) {
+  const auto [area, length] = surface_measure(g);
+  return 1.5 * (area / (h * h) + length / h);
+}
+
+void check_agent_count(const Garment& g, double h, std::size_t max_agents) {
+  const double agents = agents_for_voxel(g, h);
+  if (agents <= static_cast<double>(max_agents)) return;
+  const Vec3 extent = (g.positions.colwise().maxCoeff() - g.positions.colwise().minCoeff()).transpose();
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "surface: voxel size %.4g on a garment of %.4g x %.4g x %.4g would need about %.3g agents (at most %zu): "
+                "use a voxel size of at least %.3g, or 0 (automatic)",
+                h, extent.x(), extent.y(), extent.z(), agents, max_agents, auto_voxel_size(g, max_agents));
+  throw Error(text);
+}
+
 std::vector<std::uint32_t> surface_layers(const Garment& g, const SurfaceOptions& options, double voxel) {
   if (!options.layers) return {};
   return garment_layers(g, options.layer_min_area * voxel * voxel, options.layer_join * voxel);
+}
+
+double estimated_agent_count(const Garment& g, const SurfaceOptions& options) {
+  if (options.voxel == 0.0) return static_cast<double>(std::min(options.agent_budget, std::max<std::size_t>(g.vertex_count(), 1000)));
+  check_agent_count(g, options.voxel, options.max_agents);
+  return agents_for_voxel(g, options.voxel);
 }
 
 SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, const SurfaceOptions& options,
@@ -68,6 +94,7 @@ SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, co
   st.voxel_was_auto = options.voxel == 0.0;
   s.h_ = surface_voxel(g, options);
   st.voxel = s.h_;
+  check_agent_count(g, s.h_, options.max_agents);
   const VoxelGrid grid = make_voxel_grid(g, features, s.h_);
   const std::size_t nf = static_cast<std::size_t>(features.rows());
   const std::size_t nv = g.vertex_count();

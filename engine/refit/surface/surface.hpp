@@ -25,6 +25,7 @@ class BodySurface;
 struct SurfaceOptions {
   double voxel = 0.0;              // voxel size h in garment units; 0 = auto from the surface size and agent_budget
   std::size_t agent_budget = 20000;  // target agent count for the auto voxel size
+  std::size_t max_agents = 1000000;  // an explicit voxel size that needs more is refused (about 1 GB, minutes; issue 17)
   double epsilon = 1.0;            // an agent closer than this to body B keeps its warped position (eq. 14)
   int max_iterations = 500;        // Gauss-Seidel iterations, at most
   double tolerance = 1e-5;         // stop when an iteration's update has an L2 norm below this
@@ -83,6 +84,12 @@ struct SurfaceOptions {
   bool emit_from_original = true;  // re-emit each vertex from its ORIGINAL offsets to the agents (original -> optimised
                                    // rotations) instead of its warped ones: the warp's creases finer than h go away
 };
+
+/// About how many agents binding `g` with `options` makes (the automatic voxel
+/// size aims at its budget; an explicit one: face area / h^2 + line length / h,
+/// times 1.5). Throws refit::Error naming the voxel size and the garment's extent
+/// when an explicit voxel size needs more than max_agents (bind() does too).
+double estimated_agent_count(const Garment& g, const SurfaceOptions& options);
 
 struct SurfaceTimings {
   double sample = 0, agents = 0, one_ring = 0, encode = 0;  // bind (encode: at apply when encode_on_warped)

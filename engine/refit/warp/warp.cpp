@@ -90,9 +90,14 @@ Points WarpBinding::apply(const TriangleFrames& b) const {
   // Per triangle: M = F_B F_A^T (row-major 3x3), so a point's local coordinates
   // on A re-emitted on B are c_B + M (p - c_A).
   std::vector<double> m(9 * nt);
+  // A vertex whose triangles are all where they were on A keeps its position to
+  // the bit (A = B gives the garment back, issue 17), not p + (c - c) + R R^T d.
+  std::vector<std::uint8_t> moved(nt);
   parallel_for(0, nt, 4096, [&](std::size_t begin, std::size_t end) {
     for (std::size_t t = begin; t < end; ++t) {
       const Eigen::Index r = static_cast<Eigen::Index>(t);
+      moved[t] = !(a.centre.row(r) == b.centre.row(r) && a.u.row(r) == b.u.row(r) && a.v.row(r) == b.v.row(r) &&
+                   a.w.row(r) == b.w.row(r) && a.valid[t] == b.valid[t]);
       Eigen::Matrix3d fa, fb;
       fa.col(0) = a.u.row(r).transpose();
       fa.col(1) = a.v.row(r).transpose();
@@ -109,6 +114,12 @@ Points WarpBinding::apply(const TriangleFrames& b) const {
   parallel_for(0, n, kGrain, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const Vec3 p = row3(points, static_cast<Index>(i));
+      bool still = true;
+      for (Index t : triangles.row(i)) still = still && !moved[t];
+      if (still) {
+        out.row(static_cast<Eigen::Index>(i)) = p.transpose();
+        continue;
+      }
       Vec3 acc = Vec3::Zero();
       double wsum = 0.0;
       for (Index t : triangles.row(i)) {
