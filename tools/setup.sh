@@ -11,14 +11,14 @@ cd "$(dirname "$0")/.."
 packages=(cmake ninja-build g++ pkg-config libtbb-dev libeigen3-dev libembree-dev
           libgtest-dev libgmock-dev libbenchmark-dev libnanoflann-dev nlohmann-json3-dev libstb-dev
           libcli11-dev python3-numpy python3-scipy clang libclang-rt-14-dev
-          pybind11-dev python3-dev python3-pytest)
+          pybind11-dev python3-dev python3-pytest libcsv-dev python3-distributed blender)
+sudo=""
+[ "$(id -u)" -eq 0 ] || sudo="sudo"
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 if [ ${#missing[@]} -gt 0 ]; then
-  sudo=""
-  [ "$(id -u)" -eq 0 ] || sudo="sudo"
   echo "setup: installing ${missing[*]}"
   $sudo apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
@@ -27,6 +27,13 @@ fi
 jobs=$(nproc)
 cmake --preset release >/dev/null
 cmake --build --preset release -j "$jobs"
+# `import refit` in Debian's Python and in Blender (which runs it): a .pth file in its
+# site folder names the build tree's package (`cmake --install` copies it instead).
+if [ -f build/release/python/refit/__init__.py ]; then
+  site=$(/usr/bin/python3 -c 'import site; print(site.getsitepackages()[0])')
+  $sudo mkdir -p "$site"
+  echo "$PWD/build/release/python" | $sudo tee "$site/refit-build.pth" >/dev/null
+fi
 
 case "${1:-build}" in
   build) ;;

@@ -1,7 +1,12 @@
 """The Python module against the command line: same files, same options, the same
 positions to the bit; errors with the command line's message; the GIL released."""
+import ast
+import json
 import os
+import pydoc
+import re
 import subprocess
+import sys
 import threading
 
 import numpy as np
@@ -117,3 +122,119 @@ def test_shared_dress_to_two_bodies(tmp_path):
         r = binding.resize(refit.read_body(path))
         assert np.array_equal(r.positions, positions_of(out)), body
         assert r.report["collision"]["inside_after"] == 0
+
+
+def test_error_classes_are_the_command_lines_exit_classes(demo, tmp_path):
+    g = refit.read_garment(str(demo / "dress.obj"))
+    a = refit.read_body(str(demo / "A.obj"))
+    # Usage (exit 2): the values `refit resize` refuses as usage errors.
+    for kwargs, flag in (({"clearance": float("nan")}, ["--clearance", "nan"]), ({"threads": -1}, ["--threads", "-1"]),
+                         ({"units": "furlong"}, ["--units", "furlong"])):
+        with pytest.raises(refit.UsageError) as e:
+            refit.Binding(g, a, **kwargs)
+        assert isinstance(e.value, ValueError) and e.value.exit_code == 2
+        cli = subprocess.run([CLI, "resize", "--garment", str(demo / "dress.obj"), "--from", str(demo / "A.obj"),
+                              "--to", str(demo / "B.obj"), "--out", str(tmp_path / "o.obj")] + flag,
+                             capture_output=True, text=True)
+        assert cli.returncode == e.value.exit_code, cli.stderr
+    # Bad input (exit 1): the command line's code for the same file.
+    with pytest.raises(refit.InputError) as e:
+        refit.read_body(str(tmp_path / "missing.obj"))
+    cli = subprocess.run([CLI, "inspect", str(tmp_path / "missing.obj")], capture_output=True, text=True)
+    assert cli.returncode == e.value.exit_code == 1
+    assert issubclass(refit.ResourceError, MemoryError) and refit.ResourceError.exit_code == 3
+    # Features read for other units would be scaled wrongly: refused.
+    with pytest.raises(refit.UsageError):
+        refit.Binding(g, a, features=refit.read_features(str(demo / "features.json")), units="mm")
+
+
+def test_garment_and_body_from_arrays_resize_as_the_files(demo):
+    """What Blender hands over: positions and face lists, no file."""
+    g = refit.read_garment(str(demo / "dress.obj"))
+    faces = [line.split()[1:] for line in open(demo / "dress.obj") if line.startswith("f ")]
+    sizes = np.array([len(f) for f in faces])
+    indices = np.array([int(c.split("/")[0]) - 1 for f in faces for c in f])
+    from_arrays = refit.Garment(np.array(g.positions), indices, sizes)
+    assert (from_arrays.vertex_count, from_arrays.face_count) == (g.vertex_count, g.face_count)
+    a, b = refit.read_body(str(demo / "A.obj")), refit.read_body(str(demo / "B.obj"))
+    tris = np.array([[int(c) - 1 for c in line.split()[1:4]] for line in open(demo / "A.obj") if line.startswith("f ")])
+    a2, b2 = refit.Body(np.array(a.vertices), tris), refit.Body(np.array(b.vertices), tris)
+    f = refit.read_features(str(demo / "features.json"))
+    expected = refit.Binding(g, a, features=f).resize(b).positions
+    assert np.array_equal(refit.Binding(from_arrays, a2, features=f).resize(b2).positions, expected)
+    with pytest.raises(refit.InputError, match="vertex 99999 is not one of"):
+        refit.Garment(np.array(g.positions), np.array([0, 1, 99999]), np.array([3]))
+    with pytest.raises(refit.InputError, match="NaN or infinite"):
+        refit.Body(np.array([[0, 0, 0], [1, 0, 0], [np.nan, 1, 0]]), np.array([[0, 1, 2]]))
+
+
+def test_metrics_equal_refit_compare(demo, tmp_path):
+    out, rep = tmp_path / "out.obj", tmp_path / "compare.json"
+    subprocess.run([CLI, "resize", "--garment", str(demo / "dress.obj"), "--from", str(demo / "A.obj"), "--to",
+                    str(demo / "B.obj"), "--features", str(demo / "features.json"), "--out", str(out), "--quiet"],
+                   check=True)
+    subprocess.run([CLI, "compare", "--garment", str(demo / "dress.obj"), "--from", str(demo / "A.obj"), "--to",
+                    str(demo / "B.obj"), "--result", str(out), "--features", str(demo / "features.json"), "--report",
+                    str(rep)], check=True, capture_output=True)
+    cli = json.loads(rep.read_text())
+    del cli["inputs"]
+    g = refit.read_garment(str(demo / "dress.obj"))
+    got = refit.compare(g, positions_of(out), refit.read_body(str(demo / "A.obj")), refit.read_body(str(demo / "B.obj")),
+                        features=refit.read_features(str(demo / "features.json")))
+    assert got == cli
+    assert got["features"] and got["penetration"]["inside"] == 0
+    # metrics=True: the same numbers in the resize report, for the warp and the result.
+    r = refit.Binding(g, refit.read_body(str(demo / "A.obj")), metrics=True).resize(refit.read_body(str(demo / "B.obj")))
+    assert set(r.report["metrics"]) == {"warp", "result"}
+    assert r.report["metrics"]["result"]["vertices"] == g.vertex_count
+
+
+def test_progress_reaches_a_callback_and_can_cancel(demo):
+    g = refit.read_garment(str(demo / "dress.obj"))
+    stages = []
+    binding = refit.Binding(g, refit.read_body(str(demo / "A.obj")), stage="warp", progress=stages.append)
+    assert stages and stages[0].startswith("binding")
+    stages.clear()
+    binding.resize(refit.read_body(str(demo / "B.obj")), progress=stages.append)
+    assert any(s.startswith("warping") for s in stages)
+
+    def cancel(stage):
+        raise KeyboardInterrupt(stage)
+
+    with pytest.raises(KeyboardInterrupt):
+        binding.resize(refit.read_body(str(demo / "B.obj")), progress=cancel)
+
+
+def test_help_and_type_stubs_name_everything():
+    text = pydoc.render_doc(refit, renderer=pydoc.plaintext)
+    for name in refit.__all__:
+        assert name in text
+        assert getattr(refit, name).__doc__, name  # every public name documented
+    stub = ast.parse(open(os.path.join(os.path.dirname(refit.__file__), "_refit.pyi")).read())
+    stubbed = {n.name for n in stub.body if isinstance(n, (ast.ClassDef, ast.FunctionDef))}
+    assert stubbed == set(refit.__all__)
+    # Each stubbed function's parameters are those of the module's signature.
+    for node in stub.body:
+        if isinstance(node, ast.FunctionDef):
+            signature = getattr(refit, node.name).__doc__.splitlines()[0]
+            names = re.findall(r"(\w+): ", signature.split("(", 1)[1])
+            assert [a.arg for a in node.args.args] == names, node.name
+
+
+def test_the_readme_example_runs(tmp_path):
+    if not DATA or not os.path.isdir(os.path.join(DATA, "garments")):
+        pytest.skip("../shared/data is absent: the README's example needs it")
+    root = os.path.join(os.path.dirname(__file__), "..", "..")
+    readme = open(os.path.join(root, "README.md")).read()
+    code = readme.split("```python\n", 1)[1].split("```", 1)[0]
+    assert len(code.strip().splitlines()) <= 10
+    # Run from another folder: the README's paths are relative to the repository.
+    code = code.replace('"../shared/data/"', '"%s/"' % DATA).replace('"bench/', '"%s/bench/' % root)
+    package = os.path.dirname(os.path.dirname(os.path.abspath(refit.__file__)))
+    run = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True,
+                         env=dict(os.environ, PYTHONPATH=package))
+    assert run.returncode == 0, run.stderr
+    lines = run.stdout.splitlines()
+    assert [line.split()[0] for line in lines] == ["F_heavier", "F_thinner"]
+    assert "'hem':" in lines[0]
+    assert (tmp_path / "dress_on_F_heavier.obj").exists() and (tmp_path / "dress_on_F_thinner.obj").exists()

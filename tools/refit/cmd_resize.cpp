@@ -1,6 +1,7 @@
 // `refit resize`: one garment, body A, one or many bodies B. Binds once, then
 // resizes to each body; every output file is written atomically.
 #include "command.hpp"
+#include "manifest.hpp"
 #include "report_file.hpp"
 
 #include <refit/core/error.hpp>
@@ -22,7 +23,9 @@ namespace {
 
 struct ResizeArgs {
   std::string garment, from, out, out_dir, report, features, curves_out, units = "cm", stage = "full", symmetry, method = "refit";
+  std::string to_list, shard;
   std::vector<std::string> to;
+  std::vector<std::string> to_outputs;  // with --to-list: the output of each body of `to`
   std::size_t threads = 0, max_triangles = WarpOptions{}.max_triangles;
   bool quiet = false, metrics = false, paper_closeness = false, no_shape_control = false, no_collision = false, encode_on_warped = false,
        paper_surface = false, plain_sweeps = false, v_cycles = false;
@@ -48,7 +51,9 @@ std::string check_clearance(const std::string& s) {
 // in --out-dir), then --curves-out and --report.
 std::vector<std::string> output_paths(const ResizeArgs& a) {
   std::vector<std::string> outs;
-  if (!a.out_dir.empty()) {
+  if (!a.to_outputs.empty()) {
+    outs = a.to_outputs;
+  } else if (!a.out_dir.empty()) {
     for (const std::string& to : a.to)
       outs.push_back((std::filesystem::path(a.out_dir) / (std::filesystem::path(to).stem().string() + ".obj")).string());
   } else {
@@ -66,12 +71,39 @@ Stage parse_stage(const std::string& s) {
   throw Error("--stage: unknown stage '" + s + "' (use warp, features or full)");
 }
 
-int run(const ResizeArgs& a) {
+// --to-list MANIFEST [--shard I/N]: the bodies and outputs of the manifest's rows (of that shard).
+void take_manifest(ResizeArgs& a) {
+  if (!a.to.empty() || !a.out.empty() || !a.out_dir.empty())
+    throw Error("--to-list names the bodies and their outputs: give no --to, --out or --out-dir");
+  std::vector<ManifestRow> rows = read_manifest(a.to_list);
+  if (!a.shard.empty()) rows = shard_rows(rows, parse_shard(a.shard));
+  for (const ManifestRow& r : rows) {
+    a.to.push_back(r.body);
+    a.to_outputs.push_back(r.output);
+    std::error_code ec;  // as --out-dir, the outputs' folders are made
+    const std::filesystem::path folder = std::filesystem::path(r.output).parent_path();
+    if (!folder.empty()) std::filesystem::create_directories(folder, ec);
+    if (ec) throw input_error(r.output, "cannot create its folder: " + ec.message());
+  }
+}
+
+int run(ResizeArgs a) {
   Stopwatch total;
   ThreadLimit limit(a.threads);
   const Progress progress(a.quiet);
-  if (a.to.size() > 1 && a.out_dir.empty()) throw Error("several --to bodies need --out-dir DIR");
-  if (a.out.empty() && a.out_dir.empty()) throw Error("give --out FILE or --out-dir DIR");
+  if (!a.shard.empty() && a.to_list.empty()) throw Error("--shard needs --to-list");
+  if (!a.to_list.empty()) {
+    take_manifest(a);
+    if (a.to.empty()) {
+      progress.stage("shard " + a.shard + " of " + a.to_list + " is empty");
+      return 0;
+    }
+  } else if (a.to.empty()) {
+    throw Error("give --to BODY... or --to-list MANIFEST");
+  }
+  const bool batch = a.to.size() > 1 || !a.to_list.empty();  // a failed body is skipped, exit 4
+  if (a.to.size() > 1 && a.out_dir.empty() && a.to_list.empty()) throw Error("several --to bodies need --out-dir DIR");
+  if (a.out.empty() && a.out_dir.empty() && a.to_list.empty()) throw Error("give --out FILE or --out-dir DIR");
   if (!a.out.empty() && !a.out_dir.empty()) throw Error("give --out or --out-dir, not both");
   // --method paper: every choice the paper makes, each also a switch of its own
   // (docs/method.md); an explicit --symmetry still wins.
@@ -100,7 +132,7 @@ int run(const ResizeArgs& a) {
   options.metrics = a.metrics;
   options.clearance_cm = a.clearance;
   if (!a.curves_out.empty() && a.features.empty()) throw Error("--curves-out needs --features");
-  if (!a.curves_out.empty() && a.to.size() > 1) throw Error("--curves-out works with one --to body");
+  if (!a.curves_out.empty() && batch) throw Error("--curves-out works with one --to body");
   if (!a.out_dir.empty()) {
     // --out-dir names each garment after its body's file: two bodies may not share a name.
     for (std::size_t i = 0; i < a.to.size(); ++i)
@@ -178,14 +210,14 @@ int run(const ResizeArgs& a) {
       progress.stage("done " + out);
       total.reset();
     } catch (const Error& e) {
-      if (a.to.size() == 1) throw;
+      if (!batch) throw;
       ++failed;
       std::fprintf(stderr, "refit: error: %s (body skipped)\n", e.what());
       reports.push_back({{"body_b", to}, {"error", e.what()}});
     }
   }
   if (!a.report.empty()) {
-    nlohmann::json doc = reports.size() == 1 ? reports[0] : nlohmann::json{{"version", kVersion}, {"bodies", reports}};
+    nlohmann::json doc = !batch ? reports[0] : nlohmann::json{{"version", kVersion}, {"bodies", reports}};
     write_json_report(a.report, doc);
   }
   all_outputs.commit();
@@ -204,7 +236,11 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
   auto a = std::make_shared<ResizeArgs>();
   app.add_option("--garment", a->garment, "Garment OBJ around body A")->required();
   app.add_option("--from", a->from, "Body A (OBJ, PLY, OFF or STL)")->required();
-  app.add_option("--to", a->to, "Body B, or several bodies B (then use --out-dir)")->required()->expected(1, -1);
+  app.add_option("--to", a->to, "Body B, or several bodies B (then use --out-dir)")->expected(1, -1);
+  app.add_option("--to-list", a->to_list,
+                 "Manifest CSV: body file, output file, optional name per row (instead of --to and --out)");
+  app.add_option("--shard", a->shard, "With --to-list: only the I-th of N slices of the manifest, I from 0 (job arrays)")
+      ->check(check_shard);
   app.add_option("--out", a->out, "Output OBJ (one body)");
   app.add_option("--out-dir", a->out_dir, "Output folder: writes DIR/<body-name>.obj per body");
   app.add_option("--report", a->report, "Write a JSON report");

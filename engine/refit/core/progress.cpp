@@ -9,6 +9,7 @@ namespace refit {
 
 void Progress::stage(const std::string& what) const {
   if (quiet_) return;
+  if (sink_) return sink_(what);
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   std::fprintf(stderr, "[refit %7.2fs] %s\n", s, what.c_str());
 }
