@@ -3,6 +3,7 @@
 #include <refit/io/obj_garment.hpp>
 
 #include <refit/core/error.hpp>
+#include <refit/io/obj_detail.hpp>
 #include <refit/core/parallel.hpp>
 #include <refit/io/atomic_file.hpp>
 
@@ -18,17 +19,8 @@
 
 
 namespace refit {
+namespace obj_detail {
 namespace {
-
-// Chunks of whole lines are parsed and formatted independently. The chunk
-// boundaries depend only on the text, so results do not depend on the threads.
-constexpr std::size_t kChunkBytes = std::size_t(1) << 18;
-constexpr std::size_t kMaxWarnings = 20;
-
-struct ParseFailure {
-  std::size_t line;  // 1-based, local to the chunk
-  std::string message;
-};
 
 bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
@@ -78,29 +70,6 @@ std::string quoted(std::string_view s) {
   return out;
 }
 
-struct Chunk {
-  // pass 1
-  std::size_t lines = 0, nv = 0, nvt = 0, nvn = 0, nf = 0;
-  // pass 2 (positions, normals and their spans go straight into the result)
-  std::vector<Index> face_sizes, face_v, face_n, line_sizes, line_v, point_sizes, point_v;
-  bool any_normal = false;
-  std::vector<std::pair<std::size_t, std::string>> warnings;  // local line, text (the first few)
-  std::size_t unknown = 0;                                      // unknown statements
-  std::optional<ParseFailure> failure;
-};
-
-struct Totals {
-  std::size_t v = 0, vt = 0, vn = 0;
-};
-
-/// Where pass 2 writes `v` and `vn` data, indexed by their global number.
-struct Sink {
-  Points& positions;
-  Points& normals;
-  std::vector<ObjSource::Span>& vspans;
-  std::vector<ObjSource::Span>& nspans;
-};
-
 // A UTF-8 byte-order mark before the file's first statement is not part of it
 // (issue 17: it hid the first `v` line and shifted every face index).
 const char* skip_byte_order_mark(const char* b, const char* e, const char* file_start) {
@@ -109,8 +78,8 @@ const char* skip_byte_order_mark(const char* b, const char* e, const char* file_
 
 class ChunkParser {
  public:
-  ChunkParser(std::string_view text, Chunk& out, const Sink& sink, Totals before, Totals totals)
-      : text_(text), out_(out), sink_(sink), cur_(before), totals_(totals) {}
+  ChunkParser(std::string_view text, Chunk& out, const Sink& sink, Totals before, Totals totals, bool vertices_only)
+      : text_(text), out_(out), sink_(sink), cur_(before), totals_(totals), vertices_only_(vertices_only) {}
 
   void parse(std::size_t begin, std::size_t end) {
     const char* base = text_.data();
@@ -119,7 +88,7 @@ class ChunkParser {
     try {
       for_each_line(base + begin, base + end, [&](const char* b, const char* e) {
         ++line_;
-        statement(skip_byte_order_mark(b, e, base), e);
+        statement(skip_byte_order_mark(b, e, sink_.starts_file ? base : nullptr), e);
       });
     } catch (const ParseFailure& f) {
       out_.failure = f;
@@ -219,7 +188,9 @@ class ChunkParser {
     Tokens t{b, e};
     const std::string_view kw = t.next();
     double values[7];
-    switch (classify(kw)) {
+    const Kind kind = classify(kw);
+    if (vertices_only_ && kind != Kind::kV && kind != Kind::kVn) return;
+    switch (kind) {
       case Kind::kBlank:
       case Kind::kKnown:
         return;
@@ -231,8 +202,9 @@ class ChunkParser {
         ObjSource::Span span;
         const std::size_t n = numbers(t, kw, values, 7, &span);
         if (n < 3) fail("'v' needs 3 coordinates, found " + std::to_string(n));
-        for (int k = 0; k < 3; ++k) sink_.positions(static_cast<Eigen::Index>(cur_.v), k) = values[k];
-        sink_.vspans[cur_.v] = span;
+        const std::size_t row = cur_.v - sink_.vertex_base;
+        for (int k = 0; k < 3; ++k) sink_.positions(static_cast<Eigen::Index>(row), k) = values[k];
+        sink_.vspans[row] = span;
         ++cur_.v;
         return;
       }
@@ -246,8 +218,9 @@ class ChunkParser {
         ObjSource::Span span;
         const std::size_t n = numbers(t, kw, values, 3, &span);
         if (n != 3) fail("'vn' needs 3 numbers, found " + std::to_string(n));
-        for (int k = 0; k < 3; ++k) sink_.normals(static_cast<Eigen::Index>(cur_.vn), k) = values[k];
-        sink_.nspans[cur_.vn] = span;
+        const std::size_t row = cur_.vn - sink_.normal_base;
+        for (int k = 0; k < 3; ++k) sink_.normals(static_cast<Eigen::Index>(row), k) = values[k];
+        sink_.nspans[row] = span;
         ++cur_.vn;
         return;
       }
@@ -291,15 +264,18 @@ class ChunkParser {
   Chunk& out_;
   const Sink& sink_;
   Totals cur_, totals_;
+  bool vertices_only_ = false;
   std::size_t line_ = 0;
 };
 
+}  // namespace
+
 // Pass 1: lines and v/vt/vn counts of a chunk, so that pass 2 knows every
 // chunk's starting counts and can resolve relative indices and ranges at once.
-void count_chunk(std::string_view text, std::size_t begin, std::size_t end, Chunk& c) {
+void count_chunk(std::string_view text, std::size_t begin, std::size_t end, Chunk& c, bool starts_file) {
   for_each_line(text.data() + begin, text.data() + end, [&](const char* b, const char* e) {
     ++c.lines;
-    b = skip_byte_order_mark(b, e, text.data());
+    b = skip_byte_order_mark(b, e, starts_file ? text.data() : nullptr);
     while (b < e && is_blank(*b)) ++b;
     if (e - b < 2) return;
     if (*b == 'f' && is_blank(b[1])) ++c.nf;
@@ -311,6 +287,23 @@ void count_chunk(std::string_view text, std::size_t begin, std::size_t end, Chun
       if (b[1] == 'n') ++c.nvn;
     }
   });
+}
+
+void parse_chunk(std::string_view text, std::size_t begin, std::size_t end, Chunk& c, const Sink& sink, Totals before,
+                 Totals totals, bool vertices_only) {
+  ChunkParser(text, c, sink, before, totals, vertices_only).parse(begin, end);
+}
+
+void add_chunk_warnings(const std::string& file, const Chunk& c, std::size_t first_line, std::vector<std::string>& out,
+                        std::size_t& unknown) {
+  unknown += c.unknown;
+  for (const auto& [line, w] : c.warnings)
+    if (out.size() < kMaxWarnings) out.push_back(file + ":" + std::to_string(first_line + line) + ": " + w);
+}
+
+void finish_warnings(const std::string& file, std::size_t unknown, std::vector<std::string>& out) {
+  if (unknown > out.size())
+    out.push_back(file + ": " + std::to_string(unknown - out.size()) + " more unknown statements kept verbatim");
 }
 
 void fill_csr(Csr& csr, std::vector<Chunk>& chunks, std::vector<Index> Chunk::*sizes,
@@ -336,6 +329,11 @@ void fill_csr(Csr& csr, std::vector<Chunk>& chunks, std::vector<Index> Chunk::*s
   });
 }
 
+}  // namespace obj_detail
+
+namespace {
+using namespace obj_detail;
+
 Garment parse_owned(TextBytes bytes, const std::string& file) {
   const std::string_view text = bytes.view();
   const std::size_t n = text.size();
@@ -343,14 +341,11 @@ Garment parse_owned(TextBytes bytes, const std::string& file) {
   src->file = file;
   std::vector<std::size_t>& bounds = src->chunk_begin;
   bounds.assign(1, 0);
-  while (bounds.back() < n) {
-    std::size_t b = bounds.back() + kChunkBytes;
-    if (b < n) {
-      const void* nl = std::memchr(text.data() + b, '\n', n - b);
-      b = nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - text.data()) + 1 : n;
-    }
-    bounds.push_back(std::min(b, n));
-  }
+  while (bounds.back() < n)
+    bounds.push_back(chunk_end(bounds.back(), n, [&](std::size_t at) {
+      const void* nl = std::memchr(text.data() + at, '\n', n - at);
+      return nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - text.data()) : n;
+    }));
   const std::size_t nc = bounds.size() - 1;
   std::vector<Chunk> chunks(nc);
   parallel_for(0, nc, 1, [&](std::size_t b, std::size_t e) {
@@ -371,7 +366,7 @@ Garment parse_owned(TextBytes bytes, const std::string& file) {
   const Sink sink{g.positions, src->normals, src->vertex_spans, src->normal_spans};
   parallel_for(0, nc, 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t c = b; c < e; ++c)
-      ChunkParser(text, chunks[c], sink, before[c], totals).parse(bounds[c], bounds[c + 1]);
+      parse_chunk(text, bounds[c], bounds[c + 1], chunks[c], sink, before[c], totals);
   });
   for (std::size_t c = 0; c < nc; ++c)
     if (chunks[c].failure) throw input_error(file, chunks[c].failure->message, line0[c] + chunks[c].failure->line);
@@ -401,15 +396,8 @@ Garment parse_owned(TextBytes bytes, const std::string& file) {
   }
   src->texcoords = totals.vt;
   std::size_t unknown = 0;
-  for (std::size_t c = 0; c < nc; ++c) {
-    unknown += chunks[c].unknown;
-    for (const auto& [line, w] : chunks[c].warnings)
-      if (src->warnings.size() < kMaxWarnings)
-        src->warnings.push_back(file + ":" + std::to_string(line0[c] + line) + ": " + w);
-  }
-  if (unknown > src->warnings.size())
-    src->warnings.push_back(file + ": " + std::to_string(unknown - src->warnings.size()) +
-                            " more unknown statements kept verbatim");
+  for (std::size_t c = 0; c < nc; ++c) add_chunk_warnings(file, chunks[c], line0[c], src->warnings, unknown);
+  finish_warnings(file, unknown, src->warnings);
   const std::size_t first_nl = text.find('\n');
   src->crlf = first_nl != std::string_view::npos && first_nl > 0 && text[first_nl - 1] == '\r';
   chunks.clear();

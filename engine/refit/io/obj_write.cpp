@@ -5,6 +5,7 @@
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
 #include <refit/io/atomic_file.hpp>
+#include <refit/io/obj_detail.hpp>
 
 #include <algorithm>
 #include <bit>
@@ -19,25 +20,12 @@
 
 namespace refit {
 namespace {
-
-void append_number(std::string& out, double x) {
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, x);
-  out.append(buf, r.ptr);
-}
+using obj_detail::append_xyz;
 
 void append_index(std::string& out, std::size_t i) {
   char buf[24];
   const auto r = std::to_chars(buf, buf + sizeof buf, i);
   out.append(buf, r.ptr);
-}
-
-void append_xyz(std::string& out, double x, double y, double z) {
-  append_number(out, x);
-  out.push_back(' ');
-  append_number(out, y);
-  out.push_back(' ');
-  append_number(out, z);
 }
 
 bool same_bits(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); }
@@ -191,23 +179,21 @@ Parts format_source(const Garment& g, const Points& x, const ObjSource& s, ObjWr
   };
   auto edits = std::make_shared<Edits>(Edits{std::move(moved), std::move(recomputed), std::move(normals)});
   return {s.chunk_begin.size() - 1, [&x, &s, edits](std::size_t c, std::string& out) {
-            std::size_t pos = s.chunk_begin[c];
-            const std::size_t end = s.chunk_begin[c + 1];
+            const std::size_t pos = s.chunk_begin[c], end = s.chunk_begin[c + 1];
             out.reserve(end - pos + (end - pos) / 4);
-            std::size_t vi = s.chunk_first_vertex[c], ni = s.chunk_first_normal[c];
-            const std::size_t vend = s.chunk_first_vertex[c + 1], nend = s.chunk_first_normal[c + 1];
-            while (vi < vend || ni < nend) {
-              const bool vertex = ni >= nend || (vi < vend && s.vertex_spans[vi].begin < s.normal_spans[ni].begin);
-              const std::size_t i = vertex ? vi++ : ni++;
-              if (vertex ? !edits->moved[i] : (edits->recomputed.empty() || !edits->recomputed[i])) continue;
-              const ObjSource::Span sp = vertex ? s.vertex_spans[i] : s.normal_spans[i];
-              const Points& p = vertex ? x : edits->normals;
-              const auto ii = static_cast<Eigen::Index>(i);
-              out.append(s.text.view().substr(pos, sp.begin - pos));
-              append_xyz(out, p(ii, 0), p(ii, 1), p(ii, 2));
-              pos = sp.end;
-            }
-            out.append(s.text.view().substr(pos, end - pos));
+            struct {
+              const ObjSource& s;
+              const Points& x;
+              const Edits& e;
+              ObjSource::Span vertex_span(std::size_t i) const { return s.vertex_spans[i]; }
+              ObjSource::Span normal_span(std::size_t i) const { return s.normal_spans[i]; }
+              bool moved(std::size_t i) const { return e.moved[i]; }
+              bool recomputed(std::size_t i) const { return !e.recomputed.empty() && e.recomputed[i]; }
+              Vec3 position(std::size_t i) const { return row3(x, Index(i)); }
+              Vec3 normal(std::size_t i) const { return row3(e.normals, Index(i)); }
+            } edit{s, x, *edits};
+            obj_detail::splice_chunk(s.text.view(), pos, end, s.chunk_first_vertex[c], s.chunk_first_vertex[c + 1],
+                                     s.chunk_first_normal[c], s.chunk_first_normal[c + 1], edit, out);
           }};
 }
 
