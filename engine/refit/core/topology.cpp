@@ -159,28 +159,10 @@ std::vector<std::vector<Index>> loops_from_edges(const Garment& g, const FaceEdg
   });
   if (boundary.empty()) return {};
 
-  // Boundary edges at each vertex (CSR, edge ids ascending), to chain them.
-  const std::size_t n = g.vertex_count();
-  Csr at;
-  at.offsets.assign(n + 1, 0);
-  for (std::uint64_t k : boundary) {
-    ++at.offsets[key_lo(k) + 1];
-    ++at.offsets[key_hi(k) + 1];
-  }
-  for (std::size_t v = 0; v < n; ++v) at.offsets[v + 1] += at.offsets[v];
-  at.indices.resize(at.offsets[n]);
-  {
-    std::vector<Index> fill(at.offsets.begin(), at.offsets.end() - 1);
-    for (std::size_t e = 0; e < boundary.size(); ++e) {
-      at.indices[fill[key_lo(boundary[e])]++] = static_cast<Index>(e);
-      at.indices[fill[key_hi(boundary[e])]++] = static_cast<Index>(e);
-    }
-  }
-
   // The direction a face gives each boundary edge, so loops follow the faces'
   // orientation where they are consistent.
   std::vector<std::uint8_t> forward(boundary.size(), 1);  // lo -> hi
-  std::vector<std::uint8_t> on_boundary(n, 0);
+  std::vector<std::uint8_t> on_boundary(g.vertex_count(), 0);
   for (std::uint64_t k : boundary) on_boundary[key_lo(k)] = on_boundary[key_hi(k)] = 1;
   // A boundary edge has exactly one face side, so exactly one iteration writes it.
   parallel_for(0, g.faces.rows(), 1 << 14, [&](std::size_t begin, std::size_t end) {
@@ -194,6 +176,40 @@ std::vector<std::vector<Index>> loops_from_edges(const Garment& g, const FaceEdg
       }
     }
   });
+  return boundary_loops_of(boundary, forward);
+}
+
+}  // namespace
+
+std::vector<std::vector<Index>> boundary_loops_of(const std::vector<std::uint64_t>& boundary,
+                                                  const std::vector<std::uint8_t>& forward) {
+  // The boundary's vertices renumbered in order (the walk only compares them),
+  // so it needs memory for the boundary alone.
+  std::vector<Index> vertex;
+  for (std::uint64_t k : boundary) vertex.insert(vertex.end(), {key_lo(k), key_hi(k)});
+  std::sort(vertex.begin(), vertex.end());
+  vertex.erase(std::unique(vertex.begin(), vertex.end()), vertex.end());
+  const auto local = [&](Index v) { return Index(std::lower_bound(vertex.begin(), vertex.end(), v) - vertex.begin()); };
+  const std::size_t n = vertex.size();
+  std::vector<Index> lo(boundary.size()), hi(boundary.size());
+  for (std::size_t e = 0; e < boundary.size(); ++e) lo[e] = local(key_lo(boundary[e])), hi[e] = local(key_hi(boundary[e]));
+
+  // Boundary edges at each vertex (CSR, edge ids ascending), to chain them.
+  Csr at;
+  at.offsets.assign(n + 1, 0);
+  for (std::size_t e = 0; e < boundary.size(); ++e) {
+    ++at.offsets[lo[e] + 1];
+    ++at.offsets[hi[e] + 1];
+  }
+  for (std::size_t v = 0; v < n; ++v) at.offsets[v + 1] += at.offsets[v];
+  at.indices.resize(at.offsets[n]);
+  {
+    std::vector<Index> fill(at.offsets.begin(), at.offsets.end() - 1);
+    for (std::size_t e = 0; e < boundary.size(); ++e) {
+      at.indices[fill[lo[e]]++] = static_cast<Index>(e);
+      at.indices[fill[hi[e]]++] = static_cast<Index>(e);
+    }
+  }
 
   // Walk from each unused edge; at a vertex with several unused boundary edges
   // take the one with the smallest id. Coming back to a vertex already on the
@@ -206,7 +222,7 @@ std::vector<std::vector<Index>> loops_from_edges(const Garment& g, const FaceEdg
   for (std::size_t start = 0; start < boundary.size(); ++start) {
     if (done[start]) continue;
     done[start] = 1;
-    const Index a = key_lo(boundary[start]), b = key_hi(boundary[start]);
+    const Index a = lo[start], b = hi[start];
     chain.assign({forward[start] ? a : b});
     Index cur = forward[start] ? b : a;
     pos_in_chain[chain[0]] = 0;
@@ -228,17 +244,18 @@ std::vector<std::vector<Index>> loops_from_edges(const Garment& g, const FaceEdg
         }
       if (next_edge == Index(-1)) break;
       done[next_edge] = 1;
-      cur = key_lo(boundary[next_edge]) == cur ? key_hi(boundary[next_edge]) : key_lo(boundary[next_edge]);
+      cur = lo[next_edge] == cur ? hi[next_edge] : lo[next_edge];
     }
     for (Index v : chain) pos_in_chain[v] = -1;
   }
   // Each loop starts at its smallest vertex (direction kept), so the result
   // does not depend on which edge the walk happened to start from.
-  for (auto& loop : loops) std::rotate(loop.begin(), std::min_element(loop.begin(), loop.end()), loop.end());
+  for (auto& loop : loops) {
+    std::rotate(loop.begin(), std::min_element(loop.begin(), loop.end()), loop.end());
+    for (Index& v : loop) v = vertex[v];
+  }
   return loops;
 }
-
-}  // namespace
 
 Csr vertex_adjacency(const Garment& g) {
   const std::size_t n = g.vertex_count();

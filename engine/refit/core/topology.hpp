@@ -3,6 +3,7 @@
 // edges, loose points): edge incidence, boundary loops and connected components.
 #include <refit/core/garment.hpp>
 
+#include <cstdint>
 #include <vector>
 
 namespace refit {
@@ -22,6 +23,12 @@ TopologyStats topology_stats(const Garment& g);
 /// Boundary loops of the faces (edges used by exactly one face), each an ordered
 /// closed vertex cycle (first vertex not repeated). Deterministic order.
 std::vector<std::vector<Index>> boundary_loops(const Garment& g);
+
+/// The loops boundary_loops walks, from the boundary edges `boundary` (each
+/// (lo << 32) | hi with lo < hi, ascending) and the direction its face gives
+/// each (forward[e]: lo to hi). Needs memory for the boundary only.
+std::vector<std::vector<Index>> boundary_loops_of(const std::vector<std::uint64_t>& boundary,
+                                                  const std::vector<std::uint8_t>& forward);
 
 /// Vertex adjacency (CSR, sorted, no duplicates) from faces and `l` lines.
 Csr vertex_adjacency(const Garment& g);

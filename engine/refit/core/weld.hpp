@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace refit {
@@ -36,5 +37,25 @@ double bounding_box_diagonal(const Points& p);
 /// no other point within `tolerance` (most of a garment) are found in parallel
 /// first; only the others go through the sequential clustering. Points must be finite.
 std::vector<Index> weld_points(const Points& p, double tolerance);
+
+/// weld_points in passes over chunks of rows, for point sets not in memory
+/// (the chunked mode, issue 14): the same representatives. Pass 1: mark(rows)
+/// for every chunk (any order); pass 2: candidates(rows) for every chunk (any
+/// order), the rows that may have a twin; pass 3: cluster(rows, their
+/// candidates) for every chunk in row order, which gives each chunk's
+/// representatives.
+class PointWelder {
+ public:
+  PointWelder(std::size_t points, double tolerance);
+  ~PointWelder();
+  void mark(const Points& rows);
+  std::vector<std::uint8_t> candidates(const Points& rows) const;
+  /// Rows [first, first + rows.rows()), in order after the rows before them.
+  std::vector<Index> cluster(std::size_t first, const Points& rows, const std::vector<std::uint8_t>& candidate);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace refit

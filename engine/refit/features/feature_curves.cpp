@@ -26,10 +26,9 @@ std::string fmt(double v) {
   throw input_error(s.file, "feature '" + s.name + "': " + problem);
 }
 
-void check_plane_hits(const Garment& g, const FeatureSpec& s) {
-  if (!s.plane) return;
-  // Per-block extremes, then their extremes: min and max do not depend on the
-  // order, so neither does the result.
+// Per-block extremes, then their extremes: min and max do not depend on the
+// order, so neither does the result.
+std::pair<double, double> plane_range(const Garment& g, const FeaturePlane& plane) {
   constexpr std::size_t kBlock = 1 << 15;
   const std::size_t n = g.vertex_count(), blocks = (n + kBlock - 1) / kBlock;
   constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -37,13 +36,19 @@ void check_plane_hits(const Garment& g, const FeatureSpec& s) {
   parallel_for(0, blocks, 1, [&](std::size_t b, std::size_t e) {
     for (std::size_t blk = b; blk < e; ++blk)
       for (std::size_t i = blk * kBlock; i < std::min(n, (blk + 1) * kBlock); ++i) {
-        const double d = s.plane->signed_distance(row3(g.positions, static_cast<Index>(i)));
+        const double d = plane.signed_distance(row3(g.positions, static_cast<Index>(i)));
         block_lo[blk] = std::min(block_lo[blk], d);
         block_hi[blk] = std::max(block_hi[blk], d);
       }
   });
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  double lo = kInf, hi = -kInf;
   for (std::size_t blk = 0; blk < blocks; ++blk) lo = std::min(lo, block_lo[blk]), hi = std::max(hi, block_hi[blk]);
+  return {lo, hi};
+}
+
+void check_plane_hits(const FeatureGarment& g, const FeatureSpec& s) {
+  if (!s.plane) return;
+  const auto [lo, hi] = g.plane_range(*s.plane);
   if (lo > 0.0 || hi < 0.0)
     fail(s, "the plane misses the garment (the whole garment lies " + fmt(lo > 0.0 ? lo : -hi) +
                 " units to one side of it)");
@@ -98,8 +103,8 @@ Points sub_polyline(const Points& poly, bool closed, PolylinePoint a, PolylinePo
 // A drawn curve whose plane crosses the garment may still lie far from it (a
 // B-spline 1000 cm away was silently ignored, issue 17): its farthest sample
 // from the garment's box may be at most `limit` away.
-void check_near_garment(const Garment& g, const FeatureSpec& s, const Points& samples, double limit) {
-  const Eigen::RowVector3d lo = g.positions.colwise().minCoeff(), hi = g.positions.colwise().maxCoeff();
+void check_near_garment(const FeatureGarment& g, const FeatureSpec& s, const Points& samples, double limit) {
+  const Eigen::RowVector3d lo = g.low.transpose(), hi = g.high.transpose();
   double farthest = 0.0;
   for (Eigen::Index k = 0; k < samples.rows(); ++k)
     farthest = std::max(farthest, (samples.row(k).cwiseMax(lo).cwiseMin(hi) - samples.row(k)).norm());
@@ -107,9 +112,9 @@ void check_near_garment(const Garment& g, const FeatureSpec& s, const Points& sa
     fail(s, "the curve lies up to " + fmt(farthest) + " units outside the garment's box (more than " + fmt(limit) + ")");
 }
 
-FeatureCurve build_slice(const Garment& g, const FeatureSpec& s, double diag, const FeatureCurveOptions& o,
+FeatureCurve build_slice(const FeatureGarment& g, const FeatureSpec& s, double diag, const FeatureCurveOptions& o,
                          std::uint64_t stream) {
-  const SliceResult cut = slice_garment(g, *s.plane, 1e-6 * diag);  // the default tolerance, diagonal known
+  const SliceResult cut = g.slice(*s.plane, 1e-6 * diag);  // the default tolerance, diagonal known
   if (cut.pieces.empty()) fail(s, "the plane cuts none of the garment's faces");
   std::size_t best = 0;
   double best_d = std::numeric_limits<double>::infinity();
@@ -140,18 +145,14 @@ FeatureCurve build_slice(const Garment& g, const FeatureSpec& s, double diag, co
   return make_feature_curve(s.name, sample_by_arc_length(spline, s.samples), closed, *s.plane, o, stream);
 }
 
-FeatureCurve build_boundary(const Garment& g, const FeatureSpec& s, double diag, const FeatureCurveOptions& o,
+FeatureCurve build_boundary(const FeatureGarment& g, const FeatureSpec& s, double diag, const FeatureCurveOptions& o,
                             std::uint64_t stream) {
-  const Garment w = weld_garment(g, 1e-6 * diag);  // the default tolerance, diagonal known
-  const std::vector<std::vector<Index>> loops = boundary_loops(w);
-  if (loops.empty()) fail(s, "the garment's faces have no boundary");
+  const std::vector<Points> polys = g.boundary_loops(1e-6 * diag);  // the default tolerance, diagonal known
+  if (polys.empty()) fail(s, "the garment's faces have no boundary");
   std::size_t best = 0;
   PolylinePoint best_p;
   best_p.distance = std::numeric_limits<double>::infinity();
-  std::vector<Points> polys(loops.size());
-  for (std::size_t i = 0; i < loops.size(); ++i) {
-    polys[i].resize(static_cast<Eigen::Index>(loops[i].size()), 3);
-    for (std::size_t k = 0; k < loops[i].size(); ++k) polys[i].row(static_cast<Eigen::Index>(k)) = w.positions.row(loops[i][k]);
+  for (std::size_t i = 0; i < polys.size(); ++i) {
     const PolylinePoint p = nearest_on_polyline(polys[i], true, s.near);
     if (p.distance < best_p.distance) best_p = p, best = i;
   }
@@ -159,7 +160,7 @@ FeatureCurve build_boundary(const Garment& g, const FeatureSpec& s, double diag,
   if (best_p.distance > limit)
     fail(s, "'near' is " + fmt(best_p.distance) + " units from the nearest boundary loop (more than " + fmt(limit) +
                 ", " + fmt(100 * o.near_fraction) + "% of the garment's size)");
-  if (loops[best].size() < 3) fail(s, "the boundary loop nearest 'near' has fewer than 3 vertices");
+  if (polys[best].rows() < 3) fail(s, "the boundary loop nearest 'near' has fewer than 3 vertices");
   // Start at the loop's point nearest `near`, so the samples do not depend on
   // where the loop happens to begin in the file.
   const Points& loop = polys[best];
@@ -267,7 +268,28 @@ Garment weld_garment(const Garment& g, double tolerance) {
 std::vector<FeatureCurve> build_feature_curves(const Garment& g, const std::vector<FeatureSpec>& specs,
                                                const FeatureCurveOptions& o) {
   if (g.positions.rows() == 0) throw Error("feature curves: the garment has no vertices");
-  const double diag = bounding_box_diagonal(g.positions);
+  FeatureGarment fg;
+  fg.low = g.positions.colwise().minCoeff().transpose();
+  fg.high = g.positions.colwise().maxCoeff().transpose();
+  fg.plane_range = [&g](const FeaturePlane& plane) { return plane_range(g, plane); };
+  fg.slice = [&g](const FeaturePlane& plane, double tolerance) { return slice_garment(g, plane, tolerance); };
+  fg.boundary_loops = [&g](double tolerance) {
+    const Garment w = weld_garment(g, tolerance);
+    const std::vector<std::vector<Index>> loops = boundary_loops(w);
+    std::vector<Points> polys(loops.size());
+    for (std::size_t i = 0; i < loops.size(); ++i) {
+      polys[i].resize(static_cast<Eigen::Index>(loops[i].size()), 3);
+      for (std::size_t k = 0; k < loops[i].size(); ++k) polys[i].row(static_cast<Eigen::Index>(k)) = w.positions.row(loops[i][k]);
+    }
+    return polys;
+  };
+  return build_feature_curves(fg, specs, o);
+}
+
+std::vector<FeatureCurve> build_feature_curves(const FeatureGarment& g, const std::vector<FeatureSpec>& specs,
+                                               const FeatureCurveOptions& o) {
+  // bounding_box_diagonal's value, from the box.
+  const double diag = Eigen::RowVector3d((g.high - g.low).transpose()).norm();
   std::vector<FeatureCurve> out;
   out.reserve(specs.size());
   for (std::size_t i = 0; i < specs.size(); ++i) {

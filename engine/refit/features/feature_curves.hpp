@@ -4,8 +4,11 @@
 #include <refit/core/garment.hpp>
 #include <refit/features/feature_file.hpp>
 #include <refit/features/plane.hpp>
+#include <refit/features/slice.hpp>
 
 #include <cstdint>
+#include <functional>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -56,6 +59,20 @@ FeatureCurve make_feature_curve(std::string name, Points samples, bool closed, c
 /// from every candidate, the garment has no boundary, or an open slice gets
 /// fewer than 5 samples.
 std::vector<FeatureCurve> build_feature_curves(const Garment& g, const std::vector<FeatureSpec>& specs,
+                                               const FeatureCurveOptions& options = {});
+
+/// What build_feature_curves reads of a garment, so that a garment not in
+/// memory (the chunked mode, issue 14) gives the same curves.
+struct FeatureGarment {
+  Vec3 low = Vec3::Zero(), high = Vec3::Zero();  // the positions' bounding box
+  /// The lowest and highest signed distance of a vertex to a plane.
+  std::function<std::pair<double, double>(const FeaturePlane&)> plane_range;
+  /// slice_garment(garment, plane, weld_tolerance).
+  std::function<SliceResult(const FeaturePlane&, double)> slice;
+  /// boundary_loops(weld_garment(garment, weld_tolerance)), each loop's positions.
+  std::function<std::vector<Points>(double)> boundary_loops;
+};
+std::vector<FeatureCurve> build_feature_curves(const FeatureGarment& g, const std::vector<FeatureSpec>& specs,
                                                const FeatureCurveOptions& options = {});
 
 /// `g` with coincident vertices (closer than `tolerance`, <= 0: 1e-6 of the bbox

@@ -17,7 +17,7 @@ Vec3 mirror_dir(const Vec3& d) { return {-d.x(), d.y(), d.z()}; }
 // 95th percentile: robust to a few one-sided details (a button, a label).
 double percentile95(std::vector<double> d) {
   if (d.empty()) return 0.0;
-  const std::size_t k = std::min(d.size() - 1, static_cast<std::size_t>(0.95 * static_cast<double>(d.size())));
+  const std::size_t k = percentile95_rank(d.size());
   std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(k), d.end());
   return d[k];
 }
@@ -55,11 +55,21 @@ double mirror_plane_x(const Points& body_a) {
 
 SymmetryCheck check_symmetry(double plane_x, const std::vector<double>& garment_mirror_distance, const Points& body_a,
                              double tolerance, SymmetryMode mode) {
+  if (mode == SymmetryMode::None) return check_symmetry(plane_x, 0.0, body_a, tolerance, mode);
+  return check_symmetry(plane_x, percentile95(garment_mirror_distance), body_a, tolerance, mode);
+}
+
+std::size_t percentile95_rank(std::size_t count) {
+  return count == 0 ? 0 : std::min(count - 1, static_cast<std::size_t>(0.95 * static_cast<double>(count)));
+}
+
+SymmetryCheck check_symmetry(double plane_x, double garment_error, const Points& body_a, double tolerance,
+                             SymmetryMode mode) {
   SymmetryCheck s;
   s.tolerance = tolerance;
   s.plane_x = plane_x;
   if (mode == SymmetryMode::None) return s;
-  s.garment_error = percentile95(garment_mirror_distance);
+  s.garment_error = garment_error;
   s.body_error = percentile95(vertex_mirror_distance(body_a, plane_x));
   s.symmetric = mode == SymmetryMode::X || (s.garment_error <= tolerance && s.body_error <= tolerance);
   return s;

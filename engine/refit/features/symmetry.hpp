@@ -33,6 +33,10 @@ double mirror_plane_x(const Points& body_a);
 /// meshes need not be vertex-symmetric). tolerance: in the garment's units.
 SymmetryCheck check_symmetry(double plane_x, const std::vector<double>& garment_mirror_distance, const Points& body_a,
                              double tolerance, SymmetryMode mode);
+/// The same with the garment's error (the 95th percentile of those distances) given.
+SymmetryCheck check_symmetry(double plane_x, double garment_error, const Points& body_a, double tolerance, SymmetryMode mode);
+/// The rank (0-based, ascending) of the 95th percentile among `count` values.
+std::size_t percentile95_rank(std::size_t count);
 
 /// p mirrored about x = c.
 Points mirror_x(const Points& p, double c);

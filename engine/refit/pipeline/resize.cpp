@@ -7,6 +7,7 @@
 #include <refit/metrics/metrics.hpp>
 #include <refit/pipeline/resize.hpp>
 #include <refit/pipeline/input_checks.hpp>
+#include <refit/pipeline/resize_report.hpp>
 #include <refit/pipeline/units.hpp>
 
 #include <cstdio>
@@ -14,86 +15,6 @@
 #include <optional>
 
 namespace refit {
-
-namespace {
-
-Points concat_rows(const std::vector<const Points*>& parts) {
-  Eigen::Index n = 0;
-  for (const Points* p : parts) n += p->rows();
-  Points out(n, 3);
-  Eigen::Index r = 0;
-  for (const Points* p : parts) {
-    out.middleRows(r, p->rows()) = *p;
-    r += p->rows();
-  }
-  return out;
-}
-
-nlohmann::json surface_report(const SurfaceStats& s) {
-  return {{"agents", s.agents},
-          {"garment_agents", s.garment_agents},
-          {"feature_agents", s.feature_agents},
-          {"layers", s.layers},
-          {"voxel", s.voxel},
-          {"voxel_auto", s.voxel_was_auto},
-          {"one_ring_degree_mean", s.ring_degree_mean},
-          {"one_ring_degree_max", s.ring_degree_max},
-          {"fixed_body", s.fixed_body},
-          {"fixed_feature", s.fixed_feature},
-          {"fixed_clearance", s.fixed_clearance},
-          {"clearance_rounds", s.clearance_rounds},
-          {"anchored", s.anchored},
-          {"anchored_groups", s.anchored_groups},
-          {"anchored_followed", s.anchored_followed},
-          {"iterations", s.iterations},
-          {"final_update", s.final_update},
-          {"converged", s.converged},
-          {"vertices_without_agent", s.vertices_without_agent},
-          {"vertices_kept_near_body", s.vertices_kept},
-          {"feature_zone_agents", s.feature_zone_agents},
-          {"feature_gap_before_snap", s.feature_gap_before_snap},
-          {"feature_gap", s.feature_gap},
-          {"vertices_snapped", s.vertices_snapped},
-          {"levels", s.levels},
-          {"coarse_iterations", s.coarse_iterations},
-          {"krylov_iterations", s.krylov_iterations},
-          {"residual_reduction", s.reduction},
-          {"tolerance", s.tolerance},
-          {"timings_ms",
-           {{"sample", s.ms.sample},
-            {"agents", s.ms.agents},
-            {"one_ring", s.ms.one_ring},
-            {"encode", s.ms.encode},
-            {"solve", s.ms.solve},
-            {"reconstruct", s.ms.reconstruct}}}};
-}
-
-// Every feature figure of the report measured on the written garment (after
-// the collision step, issue 13), the surface step's own beside it.
-void report_written_features(const SurfaceAttachment& attachment, const FeatureResult& curves,
-                             const ResizeResult& result, const Points& before_collision, nlohmann::json& report) {
-  auto& list = report["features"];
-  const Points on_result = carry(attachment, result.positions);
-  const Points on_warp = carry(attachment, result.warped);
-  Eigen::Index first = 0;
-  double gap = 0.0;
-  for (std::size_t i = 0; i < curves.curves.size(); ++i) {
-    const CurveResult& c = curves.curves[i];
-    const Eigen::Index m = c.original.rows();
-    list[i]["shape_error_output"] = shape_error(on_result.middleRows(first, m), c.original, c.closed);
-    list[i]["shape_error_output_before_collision"] = shape_error(before_collision.middleRows(first, m), c.original, c.closed);
-    // The same measure on the warped garment: on a coarse mesh, carrying samples
-    // on its faces adds faceting that the free-point warp of the samples has not.
-    list[i]["shape_error_output_warped"] = shape_error(on_warp.middleRows(first, m), c.original, c.closed);
-    const double curve_gap = (on_result.middleRows(first, m) - c.optimised).rowwise().norm().maxCoeff();
-    list[i]["gap_output"] = curve_gap;
-    gap = std::max(gap, curve_gap);
-    first += m;
-  }
-  report["surface"]["feature_gap_written"] = gap;
-}
-
-}  // namespace
 
 nlohmann::json garment_summary(const Garment& g) {
   return {{"vertices", g.vertex_count()},
@@ -271,23 +192,7 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
     curves = optimise_features(*features_, frames_b, distance_b);
     if (symmetric_b && !feature_mirror_.empty()) symmetrise_curves(curves, feature_mirror_, mirror_x_);
     timings["features"] = clock.ms();
-    nlohmann::json& list = report["features"];
-    list = nlohmann::json::array();
-    for (const CurveResult& c : curves.curves) {
-      nlohmann::json fixed = nlohmann::json::array();
-      for (const FixedSample& f : c.fixed) fixed.push_back({{"index", f.index}, {"reason", f.reason}, {"distance", f.distance}});
-      nlohmann::json crossings = nlohmann::json::array();
-      for (const FixedSample& f : c.crossings) crossings.push_back({{"index", f.index}, {"distance", f.distance}});
-      list.push_back({{"name", c.name},
-                      {"samples", c.original.rows()},
-                      {"closed", c.closed},
-                      {"fixed", fixed},
-                      {"crossings", crossings},
-                      {"shape_error_warped", c.shape_error_warped},
-                      {"shape_error_result", c.shape_error_result},
-                      {"turning_angle_change_warped_deg", c.turning_angle_change_warped_deg},
-                      {"turning_angle_change_result_deg", c.turning_angle_change_result_deg}});
-    }
+    report["features"] = features_report(curves);
   }
 
   // Step 3: the surface follows the curves and keeps its local shape (section 5).
@@ -341,7 +246,8 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
       result.warnings.push_back(std::to_string(c.inside_after) + " vertices are still inside body B after collision resolution");
   }
   if (surface_ && !curves.curves.empty())
-    report_written_features(feature_attachment_, curves, result, feature_before_collision, report);
+    report_written_features(curves, carry(feature_attachment_, result.positions), carry(feature_attachment_, result.warped),
+                            feature_before_collision, report);
   if (options_.metrics) {
     clock.reset();
     progress.stage("measuring");

@@ -3,6 +3,7 @@
 #include <refit/core/parallel.hpp>
 #include <refit/core/weld.hpp>
 #include <refit/surface/agents.hpp>
+#include <refit/surface/samples.hpp>
 
 #include <tbb/parallel_sort.h>
 
@@ -11,11 +12,13 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <tuple>
 
 namespace refit {
 
 namespace {
+using namespace sampling;
 constexpr std::size_t kGrain = 2048;
 constexpr std::uint32_t kMaxCell = (1u << 21) - 1;
 
@@ -38,54 +41,6 @@ void check_garment(const Garment& g) {
     for (Index v : c->indices)
       if (v >= n) throw Error("surface: garment element refers to vertex " + std::to_string(v + 1) + " of " + std::to_string(n));
 }
-
-// Face f fan triangle t: corners 0, t+1, t+2.
-inline double tri_area(const Vec3& a, const Vec3& b, const Vec3& c) { return 0.5 * (b - a).cross(c - a).norm(); }
-
-// Subdivision of a triangle (m^2 sub-triangles, one sample at each centroid) so that
-// a sub-triangle's area is at most (h/2)^2 / 2. Triangles far smaller than a sample
-// spacing get none: their corners (vertex samples) already cover them.
-inline std::uint32_t face_subdivision(double area, double spacing) {
-  const double m = std::sqrt(2.0 * area) / spacing;
-  if (m < 0.5) return 0;
-  return static_cast<std::uint32_t>(std::ceil(m));
-}
-inline std::uint32_t segment_samples(double length, double spacing) {
-  const double m = length / spacing;
-  if (m < 0.5) return 0;
-  return static_cast<std::uint32_t>(std::ceil(m));
-}
-
-// The k-th of the m^2 centroids of a triangle subdivided m times: barycentric weights.
-inline std::array<double, 3> lattice_point(std::uint32_t m, std::uint32_t k) {
-  // Row r holds 2r+1 sub-triangles (r up triangles, r+1... ): walk rows.
-  std::uint32_t r = static_cast<std::uint32_t>(std::sqrt(static_cast<double>(k)));
-  while (r * r > k) --r;
-  while ((r + 1) * (r + 1) <= k) ++r;
-  const std::uint32_t j = k - r * r;  // 0 .. 2r within row r
-  // Coordinates on the lattice (s along edge 01, t along edge 02), in units of 1/m.
-  double s, t;
-  const std::uint32_t q = j / 2;
-  if (j % 2 == 0) {  // upward sub-triangle (q, r-q), (q+1, r-q), (q, r-q+1) in (s, t)
-    s = q + 1.0 / 3.0;
-    t = (r - q) + 1.0 / 3.0;
-  } else {  // downward sub-triangle
-    s = q + 2.0 / 3.0;
-    t = (r - q - 1) + 2.0 / 3.0;
-  }
-  s /= m;
-  t /= m;
-  return {1.0 - s - t, s, t};
-}
-
-struct SampleKey {
-  std::uint64_t voxel;
-  std::uint64_t rank;  // float bits of squared distance to the voxel centre, then sample number
-  std::uint32_t layer;
-  bool operator<(const SampleKey& o) const {
-    return std::tie(voxel, layer, rank) < std::tie(o.voxel, o.layer, o.rank);
-  }
-};
 
 Index find_root(std::vector<Index>& parent, Index a) {
   while (parent[a] != a) a = parent[a] = parent[parent[a]];
@@ -114,6 +69,12 @@ Vec3 VoxelGrid::centre(const std::array<std::uint32_t, 3>& c) const {
 
 std::uint64_t VoxelGrid::morton(const std::array<std::uint32_t, 3>& c) {
   return spread3(c[0]) | (spread3(c[1]) << 1) | (spread3(c[2]) << 2);
+}
+
+sampling::SampleKey sample_key(const VoxelGrid& grid, const Vec3& p, std::uint64_t id, std::uint32_t layer) {
+  const auto c = grid.cell(p);
+  const float d2 = static_cast<float>((p - grid.centre(c)).squaredNorm());
+  return {VoxelGrid::morton(c), (std::uint64_t(std::bit_cast<std::uint32_t>(d2)) << 32) | id, layer};
 }
 
 Points GarmentAgents::positions(const Points& x) const {
@@ -149,25 +110,35 @@ std::pair<double, double> surface_measure(const Garment& g) {
 double auto_voxel_size(const Garment& g, std::size_t agent_budget) {
   if (agent_budget == 0) throw Error("surface: the agent budget must be at least 1");
   const auto [area, length] = surface_measure(g);
+  if (g.vertex_count() == 0) return auto_voxel_size(area, length, std::nullopt, agent_budget);
+  const Vec3 ext = g.positions.colwise().maxCoeff() - g.positions.colwise().minCoeff();
+  return auto_voxel_size(area, length, ext, agent_budget);
+}
+
+double auto_voxel_size(double area, double length, const std::optional<Vec3>& extent, std::size_t agent_budget) {
+  if (agent_budget == 0) throw Error("surface: the agent budget must be at least 1");
   const double b = static_cast<double>(agent_budget) / 1.5;
   // b h^2 - L h - A = 0.
   double h = (length + std::sqrt(length * length + 4.0 * b * area)) / (2.0 * b);
   if (!(h > 0.0)) {
-    if (g.vertex_count() == 0) throw Error("surface: the garment has no vertices");
-    const Vec3 ext = g.positions.colwise().maxCoeff() - g.positions.colwise().minCoeff();
-    h = ext.norm() / std::cbrt(static_cast<double>(agent_budget));
+    if (!extent) throw Error("surface: the garment has no vertices");
+    h = extent->norm() / std::cbrt(static_cast<double>(agent_budget));
     if (!(h > 0.0)) h = 1.0;  // every vertex at one point: any size works
   }
   return h;
 }
 
 VoxelGrid make_voxel_grid(const Garment& g, const Points& extra, double h) {
-  if (!(h > 0.0) || !std::isfinite(h)) throw Error("surface: the voxel size must be positive and finite");
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   if (g.vertex_count() > 0) {
     lo = g.positions.colwise().minCoeff().transpose();
     hi = g.positions.colwise().maxCoeff().transpose();
   }
+  return make_voxel_grid(lo, hi, extra, h);
+}
+
+VoxelGrid make_voxel_grid(Vec3 lo, Vec3 hi, const Points& extra, double h) {
+  if (!(h > 0.0) || !std::isfinite(h)) throw Error("surface: the voxel size must be positive and finite");
   if (extra.rows() > 0) {
     lo = lo.cwiseMin(extra.colwise().minCoeff().transpose());
     hi = hi.cwiseMax(extra.colwise().maxCoeff().transpose());
@@ -308,11 +279,6 @@ GarmentAgents select_agents(const Garment& g, const VoxelGrid& grid, const std::
   const std::uint64_t total = nv + face_off[nf] + line_off[nl];
   if (total >= (1ull << 32)) throw Error("surface: more than 2^32 samples; use a larger voxel size");
 
-  // A sample as (vertices, weights).
-  struct Sample {
-    std::array<Index, 3> v;
-    std::array<double, 3> w;
-  };
   auto visit_face = [&](std::size_t f, auto&& emit) {
     auto r = g.faces.row(f);
     std::uint64_t k = nv + face_off[f];
@@ -332,17 +298,11 @@ GarmentAgents select_agents(const Garment& g, const VoxelGrid& grid, const std::
       }
     }
   };
-  auto position = [&](const Sample& s) {
-    return Vec3(s.w[0] * row3(x, s.v[0]) + s.w[1] * row3(x, s.v[1]) + s.w[2] * row3(x, s.v[2]));
-  };
+  auto position = [&](const Sample& s) { return sample_position(s, row3(x, s.v[0]), row3(x, s.v[1]), row3(x, s.v[2])); };
 
   std::vector<SampleKey> keys(total);
   auto key_of = [&](std::uint64_t id, const Sample& s) {
-    const Vec3 p = position(s);
-    const auto c = grid.cell(p);
-    const float d2 = static_cast<float>((p - grid.centre(c)).squaredNorm());
-    keys[id] = SampleKey{VoxelGrid::morton(c), (std::uint64_t(std::bit_cast<std::uint32_t>(d2)) << 32) | id,
-                         vertex_layer.empty() ? 0u : vertex_layer[s.v[0]]};
+    keys[id] = sample_key(grid, position(s), id, vertex_layer.empty() ? 0u : vertex_layer[s.v[0]]);
   };
   parallel_for(0, nv, kGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) key_of(i, Sample{{Index(i), Index(i), Index(i)}, {1.0, 0.0, 0.0}});

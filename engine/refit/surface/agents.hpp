@@ -4,11 +4,13 @@
 // garment (polygon soups, non-manifold faces, `l` polylines, `p` points and
 // unreferenced vertices alike).
 #include <refit/core/garment.hpp>
+#include <refit/surface/samples.hpp>
 
 #include <array>
 #include <compare>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -25,6 +27,10 @@ struct VoxelGrid {
   /// 63-bit Morton (Z-order) key of a cell.
   static std::uint64_t morton(const std::array<std::uint32_t, 3>& c);
 };
+
+/// The key by which select_agents elects, per voxel and layer, the sample at
+/// `p` (sample number `id`) nearest the voxel's centre (the smallest key wins).
+sampling::SampleKey sample_key(const VoxelGrid& grid, const Vec3& p, std::uint64_t id, std::uint32_t layer);
 
 /// Garment agents: each is a linear combination of up to three garment vertices
 /// (vertex, point on a hanging edge, point in a face), so its position is known
@@ -50,10 +56,14 @@ std::pair<double, double> surface_measure(const Garment& g);
 /// more voxels than its area / h^2), or the bounding box diagonal / cbrt(budget)
 /// for a garment of points only.
 double auto_voxel_size(const Garment& g, std::size_t agent_budget);
+/// The same from the garment's face area, line length and bounding box extent (none: no vertex).
+double auto_voxel_size(double area, double length, const std::optional<Vec3>& extent, std::size_t agent_budget);
 
 /// The grid of voxel size h over the bounding box of `g`'s positions and of `extra` points.
 /// Throws refit::Error when h is not positive and finite or the box needs more than 2^21 voxels per axis.
 VoxelGrid make_voxel_grid(const Garment& g, const Points& extra, double h);
+/// The same over the box [lo, hi] (a garment's positions' box) and `extra`.
+VoxelGrid make_voxel_grid(Vec3 lo, Vec3 hi, const Points& extra, double h);
 
 /// Layers of a garment (beyond the paper, which samples all of a garment into
 /// one voxel grid: where two layers lie closer than a voxel, such as a dress

@@ -16,7 +16,9 @@ namespace refit {
 
 namespace {
 
-void check_options(const SurfaceOptions& o) {
+}  // namespace
+
+void check_surface_options(const SurfaceOptions& o) {
   auto bad = [](const std::string& m) { return Error("surface: " + m); };
   if (!(o.voxel >= 0.0) || !std::isfinite(o.voxel)) throw bad("voxel size must be 0 (auto) or positive");
   if (o.voxel == 0.0 && o.agent_budget == 0) throw bad("agent budget must be at least 1");
@@ -40,8 +42,6 @@ void check_options(const SurfaceOptions& o) {
     throw bad("snap regularisation must be positive");
 }
 
-}  // namespace
-
 double surface_voxel(const Garment& g, const SurfaceOptions& options) {
   if (options.voxel != 0.0) return options.voxel;
   // More agents than vertices adds no detail the reconstruction could show; it only slows the solve.
@@ -56,14 +56,19 @@ double agents_for_voxel(const Garment& g, double h) {
 }
 
 void check_agent_count(const Garment& g, double h, std::size_t max_agents) {
-  const double agents = agents_for_voxel(g, h);
-  if (agents <= static_cast<double>(max_agents)) return;
+  const auto [area, length] = surface_measure(g);
   const Vec3 extent = (g.positions.colwise().maxCoeff() - g.positions.colwise().minCoeff()).transpose();
+  check_agent_count(area, length, extent, h, max_agents);
+}
+
+void check_agent_count(double area, double length, const Vec3& extent, double h, std::size_t max_agents) {
+  const double agents = 1.5 * (area / (h * h) + length / h);
+  if (agents <= static_cast<double>(max_agents)) return;
   char text[320];
   std::snprintf(text, sizeof text,
                 "surface: voxel size %.4g on a garment of %.4g x %.4g x %.4g would need about %.3g agents (at most %zu): "
                 "use a voxel size of at least %.3g, or 0 (automatic)",
-                h, extent.x(), extent.y(), extent.z(), agents, max_agents, auto_voxel_size(g, max_agents));
+                h, extent.x(), extent.y(), extent.z(), agents, max_agents, auto_voxel_size(area, length, extent, max_agents));
   throw Error(text);
 }
 
@@ -78,70 +83,111 @@ double estimated_agent_count(const Garment& g, const SurfaceOptions& options) {
   return agents_for_voxel(g, options.voxel);
 }
 
+std::vector<std::uint32_t> feature_layers(std::size_t nf, const SurfaceAttachment& at,
+                                          const std::function<std::uint32_t(Index)>& vertex_layer) {
+  std::vector<std::uint32_t> feature_layer(nf, 0);
+  if (vertex_layer && !at.vertex.empty())
+    for (std::size_t k = 0; k < nf; ++k) {
+      const auto& w = at.weight[k];
+      const int j = int(std::max_element(w.begin(), w.end()) - w.begin());
+      feature_layer[k] = vertex_layer(at.vertex[k][j]);
+    }
+  return feature_layer;
+}
+
+std::vector<VoxelLayer> feature_skip(const VoxelGrid& grid, const Points& features,
+                                     const std::vector<std::uint32_t>& feature_layer) {
+  std::vector<VoxelLayer> skip(feature_layer.size());
+  for (std::size_t k = 0; k < skip.size(); ++k)
+    skip[k] = {VoxelGrid::morton(grid.cell(row3(features, Index(k)))), feature_layer[k]};
+  std::sort(skip.begin(), skip.end());
+  skip.erase(std::unique(skip.begin(), skip.end()), skip.end());
+  return skip;
+}
+
 SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, const SurfaceOptions& options,
                                     const SurfaceAttachment* feature_attachment) {
-  check_options(options);
+  check_surface_options(options);
   check_finite(features, "feature sample");
-  SurfaceBinding s;
-  s.options_ = options;
-  s.vertex_count_ = g.vertex_count();
-  SurfaceStats& st = s.stats_;
   Stopwatch clock;
 
   // Everything here is bound on the ORIGINAL garment, not on the warped one as in
   // the paper: agents, rings and encoding then serve every body B, and the
   // encoding is the original local shape the step restores (DESIGN.md).
-  st.voxel_was_auto = options.voxel == 0.0;
-  s.h_ = surface_voxel(g, options);
-  st.voxel = s.h_;
-  check_agent_count(g, s.h_, options.max_agents);
-  const VoxelGrid grid = make_voxel_grid(g, features, s.h_);
+  SurfaceGarmentPart part;
+  part.voxel_auto = options.voxel == 0.0;
+  part.voxel = surface_voxel(g, options);
+  check_agent_count(g, part.voxel, options.max_agents);
+  part.grid = make_voxel_grid(g, features, part.voxel);
+  part.vertex_count = g.vertex_count();
   const std::size_t nf = static_cast<std::size_t>(features.rows());
-  const std::size_t nv = g.vertex_count();
   // Feature samples move with the garment where they sit (when they have no
   // warped position) and belong to its layer there.
-  if (nf > 0 && nv > 0) {
+  SurfaceAttachment attachment;
+  if (nf > 0 && part.vertex_count > 0) {
     if (feature_attachment && feature_attachment->vertex.size() != nf)
       throw Error("surface: the feature attachment has " + std::to_string(feature_attachment->vertex.size()) +
                   " samples, the features " + std::to_string(nf));
-    s.feature_attachment_ = feature_attachment ? *feature_attachment : attach_points(g, features);
+    attachment = feature_attachment ? *feature_attachment : attach_points(g, features);
   }
-  const std::vector<std::uint32_t> vertex_layer = surface_layers(g, options, s.h_);
-  std::vector<std::uint32_t> feature_layer(nf, 0);
-  if (!vertex_layer.empty() && !s.feature_attachment_.vertex.empty())
-    for (std::size_t k = 0; k < nf; ++k) {
-      const auto& w = s.feature_attachment_.weight[k];
-      const int j = int(std::max_element(w.begin(), w.end()) - w.begin());
-      feature_layer[k] = vertex_layer[s.feature_attachment_.vertex[k][j]];
-    }
-  std::vector<std::uint64_t> feature_voxel(nf);
-  std::vector<VoxelLayer> skip(nf);
-  for (std::size_t k = 0; k < nf; ++k) {
-    feature_voxel[k] = VoxelGrid::morton(grid.cell(row3(features, Index(k))));
-    skip[k] = {feature_voxel[k], feature_layer[k]};
-  }
-  std::sort(skip.begin(), skip.end());
-  skip.erase(std::unique(skip.begin(), skip.end()), skip.end());
-  st.ms.sample = clock.ms();
+  const std::vector<std::uint32_t> vertex_layer = surface_layers(g, options, part.voxel);
+  part.layers = vertex_layer.empty() ? 0 : *std::max_element(vertex_layer.begin(), vertex_layer.end());
+  std::function<std::uint32_t(Index)> layer_of;
+  if (!vertex_layer.empty()) layer_of = [&](Index v) { return vertex_layer[v]; };
+  part.feature_layer = feature_layers(nf, attachment, layer_of);
+  part.ms.sample = clock.ms();
   clock.reset();
+  part.agents = select_agents(g, part.grid, feature_skip(part.grid, features, part.feature_layer), vertex_layer);
+  part.agent_positions = part.agents.positions(g.positions);
+  part.ms.agents = clock.ms();
 
-  GarmentAgents ga = select_agents(g, grid, skip, vertex_layer);
+  SurfaceBinding s = bind_agents(std::move(part), features, options, std::move(attachment));
+  clock.reset();
+  s.blends_ = s.vertex_blends(g.positions, vertex_layer);
+  s.stats_.vertices_capped = s.blends_.capped;
+  s.stats_.vertices_without_agent = s.blends_.without_agent;
+  if (options.feature_zone_rings > 0) {
+    s.carries_feature_.assign(s.vertex_count_, 0);
+    for (std::size_t k = 0; k < s.feature_attachment_.vertex.size(); ++k)
+      for (int j = 0; j < 3; ++j)
+        if (s.feature_attachment_.weight[k][j] != 0.0) s.carries_feature_[s.feature_attachment_.vertex[k][j]] = 1;
+  }
+  if (options.emit_from_original && !options.encode_on_warped) s.original_vertices_ = g.positions;
+  s.stats_.ms.reconstruct = clock.ms();  // bind share of the reconstruction (vertex lists)
+  return s;
+}
+
+SurfaceBinding SurfaceBinding::bind_agents(SurfaceGarmentPart part, const Points& features, const SurfaceOptions& options,
+                                           SurfaceAttachment feature_attachment) {
+  check_surface_options(options);
+  check_finite(features, "feature sample");
+  SurfaceBinding s;
+  s.options_ = options;
+  s.vertex_count_ = part.vertex_count;
+  s.h_ = part.voxel;
+  s.feature_attachment_ = std::move(feature_attachment);
+  SurfaceStats& st = s.stats_;
+  st.voxel_was_auto = part.voxel_auto;
+  st.voxel = s.h_;
+  st.ms.sample = part.ms.sample;
+  Stopwatch clock;
+  const std::size_t nf = static_cast<std::size_t>(features.rows());
+  GarmentAgents& ga = part.agents;
   const std::size_t ng = ga.size(), n = ng + nf;
   st.samples = ga.samples;
   st.garment_agents = ng;
   st.feature_agents = nf;
   st.agents = n;
   Points natural(static_cast<Eigen::Index>(n), 3);
-  if (ng > 0) natural.topRows(static_cast<Eigen::Index>(ng)) = ga.positions(g.positions);
+  if (ng > 0) natural.topRows(static_cast<Eigen::Index>(ng)) = part.agent_positions;
   if (nf > 0) natural.bottomRows(static_cast<Eigen::Index>(nf)) = features;
   std::vector<std::uint64_t> morton = ga.voxel;
-  morton.insert(morton.end(), feature_voxel.begin(), feature_voxel.end());
+  for (std::size_t k = 0; k < nf; ++k) morton.push_back(VoxelGrid::morton(part.grid.cell(row3(features, Index(k)))));
   std::vector<std::uint32_t> natural_layer = ga.layer;
-  natural_layer.insert(natural_layer.end(), feature_layer.begin(), feature_layer.end());
-  st.layers = vertex_layer.empty() ? 0 : *std::max_element(vertex_layer.begin(), vertex_layer.end());
-  st.ms.agents = clock.ms();
+  natural_layer.insert(natural_layer.end(), part.feature_layer.begin(), part.feature_layer.end());
+  st.layers = part.layers;
+  st.ms.agents = part.ms.agents + clock.ms();
   clock.reset();
-
   OrderedAgents ord =
       order_agents(natural, morton, natural_layer, options.ring_radius_voxels * s.h_, options.block_voxels * s.h_);
   const std::vector<Index>& order = ord.order;
@@ -209,15 +255,6 @@ SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, co
   st.ms.encode += clock.ms();
   clock.reset();
 
-  s.bind_vertex_blends(g.positions, vertex_layer);
-  if (options.feature_zone_rings > 0) {
-    s.carries_feature_.assign(nv, 0);
-    for (std::size_t k = 0; k < s.feature_attachment_.vertex.size(); ++k)
-      for (int j = 0; j < 3; ++j)
-        if (s.feature_attachment_.weight[k][j] != 0.0) s.carries_feature_[s.feature_attachment_.vertex[k][j]] = 1;
-  }
-  if (options.emit_from_original && !options.encode_on_warped) s.original_vertices_ = g.positions;
-  st.ms.reconstruct = clock.ms();  // bind share of the reconstruction (vertex lists)
   return s;
 }
 

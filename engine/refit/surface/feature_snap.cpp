@@ -10,52 +10,73 @@ namespace refit {
 
 namespace {
 
-// Largest distance from a sample carried on `positions` to its target, over the samples not on a held vertex.
-double largest_gap(const Points& positions, const Points& targets, const SurfaceAttachment& at,
-                   const std::vector<std::uint8_t>& on_held) {
+// Sample k carried on the sample vertices' positions (moved by the corrections when given): carry_one's sums.
+Vec3 carried(const SurfaceAttachment& at, const SnapVertices& vs, Index k, const FeatureSnap* snap,
+             const std::vector<std::int32_t>* feature_of) {
+  const auto s = static_cast<std::size_t>(k);
+  Vec3 q = row3(at.offset, k);
+  for (int j = 0; j < 3; ++j) {
+    const SnapVertex& v = vs.at(at.vertex[s][j]);
+    Vec3 p = v.position;
+    if (snap && !v.held)
+      for (std::size_t r = 0; r < v.reach.size(); ++r) {
+        const std::int32_t f = (*feature_of)[v.reach[r]];
+        if (f >= 0) p += (double(v.weight[r]) * snap->correction.row(f)).transpose();
+      }
+    q += at.weight[s][j] * p;
+  }
+  return q;
+}
+
+std::vector<std::uint8_t> samples_on_held(const SurfaceAttachment& at, const SnapVertices& vs, std::size_t nf) {
+  std::vector<std::uint8_t> on_held(nf, 0);
+  for (std::size_t k = 0; k < nf; ++k)
+    for (int j = 0; j < 3; ++j) on_held[k] |= at.weight[k][j] != 0.0 && vs.at(at.vertex[k][j]).held;
+  return on_held;
+}
+
+double largest_gap(const Points& targets, const SurfaceAttachment& at, const SnapVertices& vs,
+                   const std::vector<std::uint8_t>& on_held, const FeatureSnap* snap,
+                   const std::vector<std::int32_t>* feature_of) {
   double gap = 0.0;
   for (Eigen::Index k = 0; k < targets.rows(); ++k)
-    if (!on_held[std::size_t(k)]) gap = std::max(gap, (row3(targets, Index(k)) - carry_one(at, positions, Index(k))).norm());
+    if (!on_held[std::size_t(k)]) gap = std::max(gap, (row3(targets, Index(k)) - carried(at, vs, Index(k), snap, feature_of)).norm());
   return gap;
 }
 
 }  // namespace
 
-FeatureSnapReport snap_to_features(Points& positions, const Points& targets, const SurfaceAttachment& at,
-                                   const Csr& reach, const std::vector<float>& reach_weight,
-                                   const std::vector<std::int32_t>& feature_of, const std::vector<std::uint8_t>& held,
-                                   double regularisation) {
-  FeatureSnapReport rep;
+FeatureSnap solve_feature_snap(const Points& targets, const SurfaceAttachment& at, const SnapVertices& vs,
+                               const std::vector<std::int32_t>& feature_of, bool blend_weights, double regularisation) {
+  FeatureSnap snap;
+  FeatureSnapReport& rep = snap.report;
   const auto nf = static_cast<Eigen::Index>(targets.rows());
-  auto is_held = [&](Index v) { return !held.empty() && held[v]; };
   // A sample on a held vertex asks to stay where it is: snapping the free rest of
   // its curve alone would leave a step where the held part begins.
-  std::vector<std::uint8_t> on_held(std::size_t(nf), 0);
-  for (std::size_t k = 0; k < std::size_t(nf); ++k)
-    for (int j = 0; j < 3; ++j) on_held[k] |= at.weight[k][j] != 0.0 && is_held(at.vertex[k][j]);
+  const std::vector<std::uint8_t> on_held = samples_on_held(at, vs, std::size_t(nf));
   rep.samples_held = std::size_t(std::count(on_held.begin(), on_held.end(), 1));
-  rep.gap_before = rep.gap_after = largest_gap(positions, targets, at, on_held);
-  if (nf == 0 || reach_weight.empty() || !(rep.gap_before > 0.0)) return rep;
+  rep.gap_before = rep.gap_after = largest_gap(targets, at, vs, on_held, nullptr, nullptr);
+  if (nf == 0 || !blend_weights || !(rep.gap_before > 0.0)) return snap;
   // Row k: how sample k's carried position moves with each feature agent's correction.
   Eigen::MatrixXd residual(nf, 3);
   std::vector<Eigen::Triplet<double>> entries;
   for (Eigen::Index k = 0; k < nf; ++k) {
     residual.row(k) = on_held[std::size_t(k)] ? Eigen::RowVector3d::Zero()
-                              : Eigen::RowVector3d(targets.row(k) - carry_one(at, positions, Index(k)).transpose());
+                              : Eigen::RowVector3d(targets.row(k) - carried(at, vs, Index(k), nullptr, nullptr).transpose());
     for (int j = 0; j < 3; ++j) {
       const Index v = at.vertex[std::size_t(k)][j];
       const double w = at.weight[std::size_t(k)][j];
-      if (w == 0.0 || is_held(v)) continue;
-      auto r = reach.row(v);
-      for (std::size_t q = 0; q < r.size(); ++q)
-        if (feature_of[r[q]] >= 0) entries.emplace_back(k, feature_of[r[q]], w * reach_weight[reach.offsets[v] + q]);
+      const SnapVertex& sv = vs.at(v);
+      if (w == 0.0 || sv.held) continue;
+      for (std::size_t q = 0; q < sv.reach.size(); ++q)
+        if (feature_of[sv.reach[q]] >= 0) entries.emplace_back(k, feature_of[sv.reach[q]], w * sv.weight[q]);
     }
   }
   Eigen::SparseMatrix<double> a(nf, nf);
   a.setFromTriplets(entries.begin(), entries.end());
   Eigen::SparseMatrix<double> normal = a.transpose() * a;
   const double mean_diagonal = normal.diagonal().sum() / double(nf);
-  if (!(mean_diagonal > 0.0)) return rep;
+  if (!(mean_diagonal > 0.0)) return snap;
   // The regularisation keeps corrections bounded where samples conflict (two
   // curves crossing one coarse face with slightly different targets) or where
   // a sample's vertices see a feature agent only faintly.
@@ -63,12 +84,20 @@ FeatureSnapReport snap_to_features(Points& positions, const Points& targets, con
   identity.setIdentity();
   normal += (regularisation * mean_diagonal) * identity;
   const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(normal);
-  if (ldlt.info() != Eigen::Success) return rep;
-  const Eigen::MatrixXd c = ldlt.solve(Eigen::MatrixXd(a.transpose() * residual));
+  if (ldlt.info() != Eigen::Success) return snap;
+  snap.correction = ldlt.solve(Eigen::MatrixXd(a.transpose() * residual));
+  return snap;
+}
+
+std::size_t apply_feature_snap(const FeatureSnap& snap, Points& positions, const Csr& reach,
+                               const std::vector<float>& reach_weight, const std::vector<std::int32_t>& feature_of,
+                               std::span<const std::uint8_t> held) {
+  if (snap.correction.size() == 0) return 0;
+  const Eigen::MatrixXd& c = snap.correction;
   std::vector<std::uint8_t> moved(positions.rows(), 0);
   parallel_for(0, std::size_t(positions.rows()), 4096, [&](std::size_t b, std::size_t e) {
     for (std::size_t v = b; v < e; ++v) {
-      if (is_held(Index(v))) continue;
+      if (!held.empty() && held[v]) continue;
       auto r = reach.row(v);
       for (std::size_t q = 0; q < r.size(); ++q) {
         const std::int32_t f = feature_of[r[q]];
@@ -78,9 +107,37 @@ FeatureSnapReport snap_to_features(Points& positions, const Points& targets, con
       }
     }
   });
-  for (std::uint8_t m : moved) rep.vertices_moved += m;
-  rep.gap_after = largest_gap(positions, targets, at, on_held);
-  return rep;
+  std::size_t count = 0;
+  for (std::uint8_t m : moved) count += m;
+  return count;
+}
+
+double snapped_gap(const FeatureSnap& snap, const Points& targets, const SurfaceAttachment& at, const SnapVertices& vs,
+                   const std::vector<std::int32_t>& feature_of) {
+  if (snap.correction.size() == 0) return snap.report.gap_after;
+  return largest_gap(targets, at, vs, samples_on_held(at, vs, std::size_t(targets.rows())), &snap, &feature_of);
+}
+
+FeatureSnapReport snap_to_features(Points& positions, const Points& targets, const SurfaceAttachment& at,
+                                   const Csr& reach, const std::vector<float>& reach_weight,
+                                   const std::vector<std::int32_t>& feature_of, const std::vector<std::uint8_t>& held,
+                                   double regularisation) {
+  SnapVertices vs;
+  for (const auto& corners : at.vertex)
+    for (Index v : corners) {
+      if (vs.count(v)) continue;
+      SnapVertex& sv = vs[v];
+      sv.position = row3(positions, v);
+      sv.held = !held.empty() && held[v];
+      const auto r = reach.row(v);
+      sv.reach.assign(r.begin(), r.end());
+      if (!reach_weight.empty())
+        sv.weight.assign(reach_weight.begin() + reach.offsets[v], reach_weight.begin() + reach.offsets[v + 1]);
+    }
+  FeatureSnap snap = solve_feature_snap(targets, at, vs, feature_of, !reach_weight.empty(), regularisation);
+  snap.report.vertices_moved = apply_feature_snap(snap, positions, reach, reach_weight, feature_of, held);
+  snap.report.gap_after = snapped_gap(snap, targets, at, vs, feature_of);
+  return snap.report;
 }
 
 }  // namespace refit

@@ -16,6 +16,8 @@
 #include <refit/core/types.hpp>
 
 #include <cstdint>
+#include <span>
+#include <unordered_map>
 #include <vector>
 
 namespace refit {
@@ -26,6 +28,38 @@ struct FeatureSnapReport {
   std::size_t samples_held = 0;  // samples on a held vertex: they stay where they are
   std::size_t vertices_moved = 0;
 };
+
+/// A vertex a feature sample sits on, as the snap sees it.
+struct SnapVertex {
+  Vec3 position = Vec3::Zero();  // after the reconstruction
+  bool held = false;             // must not move
+  std::vector<Index> reach;      // its agents within reach
+  std::vector<float> weight;     // ... and their blend weights
+};
+/// Every vertex of the attachment (all three of each sample, weight 0 too), by vertex.
+using SnapVertices = std::unordered_map<Index, SnapVertex>;
+
+/// The snap's solution: a correction per feature agent (its sample's row), nf x 3.
+struct FeatureSnap {
+  Eigen::MatrixXd correction;  // empty: nothing to correct
+  FeatureSnapReport report;
+};
+
+/// The corrections that carry the samples to `targets` (see above), from the
+/// sample vertices alone; report.gap_after and vertices_moved are left to the caller.
+FeatureSnap solve_feature_snap(const Points& targets, const SurfaceAttachment& attachment, const SnapVertices& vertices,
+                               const std::vector<std::int32_t>& feature_of, bool blend_weights, double regularisation);
+
+/// Moves rows of `positions` (all vertices or a chunk; `reach`, `reach_weight`
+/// and `held` theirs) by the corrections; returns how many moved.
+std::size_t apply_feature_snap(const FeatureSnap& snap, Points& positions, const Csr& reach,
+                               const std::vector<float>& reach_weight, const std::vector<std::int32_t>& feature_of,
+                               std::span<const std::uint8_t> held);
+
+/// Largest distance from a carried sample to its target over the samples not
+/// on a held vertex, with the sample vertices moved by the corrections.
+double snapped_gap(const FeatureSnap& snap, const Points& targets, const SurfaceAttachment& attachment,
+                   const SnapVertices& vertices, const std::vector<std::int32_t>& feature_of);
 
 /// Corrects `positions` (every garment vertex) so that the feature samples
 /// attached by `attachment` reach `targets`. `reach`/`reach_weight`: each

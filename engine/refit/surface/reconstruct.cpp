@@ -19,12 +19,13 @@ namespace {
 constexpr std::size_t kGrain = 1024;
 }  // namespace
 
-void SurfaceBinding::bind_vertex_blends(const Points& positions, const std::vector<std::uint32_t>& vertex_layer) {
-  const std::size_t n = agent_count(), nv = vertex_count_;
+VertexBlends SurfaceBinding::vertex_blends(const Points& positions, std::span<const std::uint32_t> vertex_layer) const {
+  const std::size_t n = agent_count(), nv = static_cast<std::size_t>(positions.rows());
+  VertexBlends out;
   // Each vertex's nearest agents within reach (a bounded k-nearest query), and the
   // nearest agent (for vertices with none).
   const std::size_t kmax = options_.max_reach_agents;
-  nearest_.assign(nv, 0);
+  out.nearest.assign(nv, 0);
   if (n > 0) {
     // A vertex of a layer blends its own layer's agents only.
     const LayerTrees tree(original_agents_, layer_);
@@ -42,7 +43,7 @@ void SurfaceBinding::bind_vertex_blends(const Points& positions, const std::vect
         std::size_t m = 0;
         while (m < idx.size() && m < kmax && d2[m] < reach2) ++m;
         capped[v] = m == kmax && idx.size() > m && d2[m] < reach2;
-        nearest_[v] = idx.empty() ? 0 : idx.front();
+        out.nearest[v] = idx.empty() ? 0 : idx.front();
         count[v] = static_cast<std::uint8_t>(m);
         std::copy(idx.begin(), idx.begin() + std::ptrdiff_t(m), idx_all.begin() + std::ptrdiff_t(v * kmax));
         if (options_.smooth_blend && m > 0) {
@@ -67,22 +68,24 @@ void SurfaceBinding::bind_vertex_blends(const Points& positions, const std::vect
         }
       }
     });
-    reach_.offsets.assign(nv + 1, 0);
-    for (std::size_t v = 0; v < nv; ++v) reach_.offsets[v + 1] = reach_.offsets[v] + count[v];
-    reach_.indices.resize(reach_.offsets[nv]);
-    if (options_.smooth_blend) reach_weight_.resize(reach_.offsets[nv]);
+    Csr& reach = out.reach;
+    reach.offsets.assign(nv + 1, 0);
+    for (std::size_t v = 0; v < nv; ++v) reach.offsets[v + 1] = reach.offsets[v] + count[v];
+    reach.indices.resize(reach.offsets[nv]);
+    if (options_.smooth_blend) out.weight.resize(reach.offsets[nv]);
     parallel_for(0, nv, 8192, [&](std::size_t b, std::size_t e) {
       for (std::size_t v = b; v < e; ++v)
         for (std::size_t j = 0; j < count[v]; ++j) {
-          reach_.indices[reach_.offsets[v] + j] = idx_all[v * kmax + j];
-          if (options_.smooth_blend) reach_weight_[reach_.offsets[v] + j] = w_all[v * kmax + j];
+          reach.indices[reach.offsets[v] + j] = idx_all[v * kmax + j];
+          if (options_.smooth_blend) out.weight[reach.offsets[v] + j] = w_all[v * kmax + j];
         }
     });
-    stats_.vertices_capped = std::accumulate(capped.begin(), capped.end(), std::size_t{0});
-    for (std::size_t v = 0; v < nv; ++v) stats_.vertices_without_agent += count[v] == 0;
+    out.capped = std::accumulate(capped.begin(), capped.end(), std::size_t{0});
+    for (std::size_t v = 0; v < nv; ++v) out.without_agent += count[v] == 0;
   } else {
-    reach_.offsets.assign(nv + 1, 0);
+    out.reach.offsets.assign(nv + 1, 0);
   }
+  return out;
 }
 
 // Beyond the paper: an anchored agent (its group has nothing fixed: a layer of
@@ -160,9 +163,8 @@ void SurfaceBinding::smooth_displacements(const Points& before, const std::vecto
 // which is what this step restores; coarser warp changes live in the agents.
 // With encode_on_warped the target shape is the warp's, so its detail stays.
 // Anchored agents that had no solved agent within reach hand their vertices back as warped.
-Points SurfaceBinding::reconstruct(const Points& warped, const Points& before, const Points& x,
-                                   const std::vector<Eigen::Matrix3d>& stretch,
-                                   const std::vector<std::uint8_t>& anchored_kept, bool some_anchored_kept) const {
+std::vector<Eigen::Matrix3d> SurfaceBinding::rotations(const Points& before, const Points& x,
+                                                       const std::vector<Eigen::Matrix3d>& stretch) const {
   const bool orig = options_.emit_from_original && !options_.encode_on_warped;
   const Points& from = orig ? original_agents_ : before;
   std::vector<Eigen::Matrix3d> rot;
@@ -174,24 +176,41 @@ Points SurfaceBinding::reconstruct(const Points& warped, const Points& before, c
   // The original offsets to the agents stretch as the encoding did.
   if (orig && !stretch.empty())
     for (std::size_t a = 0; a < rot.size(); ++a) rot[a] = rot[a] * stretch[a];
-  std::vector<std::uint8_t> keep;
-  if (orig && some_anchored_kept) keep = anchored_kept;
-  return reconstruct_rotations(orig ? original_vertices_ : warped, from, x, rot, reach_, reach_weight_, nearest_, keep,
-                               &warped);
+  return rot;
+}
+
+Points SurfaceBinding::emit_vertices(const AgentSolution& sol, const Points& original, const Points& warped,
+                                     const VertexBlends& blends, std::span<const std::uint8_t> carries_feature,
+                                     const std::function<double(const Vec3&)>& distance, std::vector<std::uint8_t>& kept,
+                                     SurfaceStats& stats) const {
+  kept.clear();
+  if (agent_count() == 0) return warped;
+  const bool orig = options_.emit_from_original && !options_.encode_on_warped;
+  Points out = reconstruct_rotations(orig ? original : warped, orig ? original_agents_ : sol.before, sol.x, sol.rotation,
+                                     blends.reach, blends.weight, blends.nearest, sol.keep, &warped);
+  if (options_.keep_near_vertices) {
+    kept = keep_near_vertices(sol, warped, blends, carries_feature, distance, out);
+    stats.vertices_kept += std::accumulate(kept.begin(), kept.end(), std::size_t{0});
+  }
+  return out;
 }
 
 // Eq. 14 for the vertices too: blending frames of nearby free agents must not
 // pull a vertex that touches the body. Only vertices the nearest agent's
 // distance cannot rule out are queried: d(v) >= d(a) - |v - a|.
-std::vector<std::uint8_t> SurfaceBinding::keep_near_vertices(const Points& warped, const Points& before,
-                                                             const std::vector<double>& body_distance,
+std::vector<std::uint8_t> SurfaceBinding::keep_near_vertices(const AgentSolution& sol, const Points& warped,
+                                                             const VertexBlends& blends,
+                                                             std::span<const std::uint8_t> carries_feature,
                                                              const std::function<double(const Vec3&)>& distance,
                                                              Points& positions) const {
-  std::vector<std::uint8_t> kept(vertex_count_, 0);
-  parallel_for(0, vertex_count_, 1024, [&](std::size_t b, std::size_t e) {
+  const std::size_t nv = static_cast<std::size_t>(warped.rows());
+  const Points& before = sol.before;
+  const std::vector<double>& body_distance = sol.body_distance;
+  std::vector<std::uint8_t> kept(nv, 0);
+  parallel_for(0, nv, 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t v = b; v < e; ++v) {
-      const Index a = nearest_[v];
-      if (!near_feature_.empty() && (near_feature_[a] || carries_feature_[v])) continue;
+      const Index a = blends.nearest[v];
+      if (!near_feature_.empty() && (near_feature_[a] || carries_feature[v])) continue;
       const Vec3 p = row3(warped, Index(v));
       if (feature_of_[a] < 0 && body_distance[a] - (p - row3(before, a)).norm() >= options_.epsilon) continue;
       if (distance(p) < options_.epsilon) {

@@ -59,6 +59,26 @@ std::vector<std::uint8_t> free_agents(const AgentRows& r, const std::vector<Inde
 }  // namespace
 
 Points SurfaceBinding::agent_positions(const Points& x, const Points* fp) const {
+  return agent_positions_of([&x](Index v) { return row3(x, v); }, fp);
+}
+
+std::vector<Index> SurfaceBinding::agent_vertices() const {
+  std::vector<Index> ids;
+  for (std::size_t a = 0; a < agent_count(); ++a)
+    if (feature_of_[a] < 0) ids.insert(ids.end(), src_vertex_[a].begin(), src_vertex_[a].end());
+  for (const auto& v : feature_attachment_.vertex) ids.insert(ids.end(), v.begin(), v.end());
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  return ids;
+}
+
+Points SurfaceBinding::agent_positions(const Points& vertices, const std::vector<Index>& ids, const Points* fp) const {
+  return agent_positions_of(
+      [&](Index v) { return row3(vertices, Index(std::lower_bound(ids.begin(), ids.end(), v) - ids.begin())); }, fp);
+}
+
+template <class Vertex>
+Points SurfaceBinding::agent_positions_of(const Vertex& x, const Points* fp) const {
   const std::size_t n = agent_count();
   Points out(static_cast<Eigen::Index>(n), 3);
   parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
@@ -66,11 +86,14 @@ Points SurfaceBinding::agent_positions(const Points& x, const Points* fp) const 
       Vec3 p = Vec3::Zero();
       const std::int32_t k = feature_of_[a];
       if (k < 0) {
-        for (int j = 0; j < 3; ++j) p += src_weight_[a][j] * row3(x, src_vertex_[a][j]);
+        for (int j = 0; j < 3; ++j) p += src_weight_[a][j] * x(src_vertex_[a][j]);
       } else if (fp) {
         p = row3(*fp, Index(k));
       } else if (!feature_attachment_.vertex.empty()) {
-        p = carry_one(feature_attachment_, x, k);
+        // carry_one's sum
+        const auto s = static_cast<std::size_t>(k);
+        p = row3(feature_attachment_.offset, Index(k));
+        for (int j = 0; j < 3; ++j) p += feature_attachment_.weight[s][j] * x(feature_attachment_.vertex[s][j]);
       } else {
         p = row3(original_agents_, Index(a));  // no garment vertex at all: nothing moved
       }
@@ -145,7 +168,7 @@ Points SurfaceBinding::coarse_to_fine_start(const Points& before, const Points& 
 SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
                                     const std::function<double(const Vec3&)>& distance, const Points* fwarped,
                                     SurfaceSystem* system) const {
-  const std::size_t n = agent_count(), nf = feature_count();
+  const std::size_t nf = feature_count();
   if (static_cast<std::size_t>(warped.rows()) != vertex_count_)
     throw Error("surface: the warped garment has " + std::to_string(warped.rows()) + " vertices, the binding expects " +
                 std::to_string(vertex_count_));
@@ -159,12 +182,41 @@ SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
   check_finite(targets, "feature target");
   if (fwarped) check_finite(*fwarped, "warped feature sample");
 
+  Stopwatch clock;
+  AgentSolution sol = solve_agents(agent_positions(warped, fwarped), targets, distance, system);
   SurfaceResult res;
-  res.stats = stats_;
+  res.stats = sol.stats;
   SurfaceStats& st = res.stats;
+  clock.reset();
+  std::vector<std::uint8_t> kept_vertex;
+  res.positions = emit_vertices(sol, original_vertices_, warped, blends_, carries_feature_, distance, kept_vertex, st);
+  if (snaps()) {
+    const FeatureSnapReport snap = snap_to_features(res.positions, targets, feature_attachment_, blends_.reach,
+                                                    blends_.weight, feature_of_, kept_vertex, options_.snap_regularisation);
+    st.feature_gap_before_snap = snap.gap_before;
+    st.feature_gap = snap.gap_after;
+    st.vertices_snapped = snap.vertices_moved;
+  }
+  res.agents = std::move(sol.x);
+  st.ms.reconstruct = clock.ms();
+  return res;
+}
+
+bool SurfaceBinding::snaps() const {
+  return options_.snap_to_features && !near_feature_.empty() && feature_count() > 0 && !feature_attachment_.vertex.empty();
+}
+
+SurfaceBinding::AgentSolution SurfaceBinding::solve_agents(Points before_in, const Points& targets,
+                                                           const std::function<double(const Vec3&)>& distance,
+                                                           SurfaceSystem* system) const {
+  const std::size_t n = agent_count(), nf = feature_count();
+  AgentSolution sol;
+  sol.before = std::move(before_in);
+  const Points& before = sol.before;
+  sol.stats = stats_;
+  SurfaceStats& st = sol.stats;
   st.ms.encode = 0.0;
   Stopwatch clock;
-  const Points before = agent_positions(warped, fwarped);
 
   // Constraints: eq. 15 for feature agents, eq. 14 within epsilon of body B
   // (or inside it: the distance is signed) except in the features' zone (see
@@ -277,28 +329,12 @@ SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
   if (st.anchored > 0) st.anchored_followed = follow_anchored(before, fixed, fr, x, anchored_kept);
   smooth_displacements(before, fr, x);
   st.ms.solve = clock.ms();
-  clock.reset();
-
-  if (n == 0) {
-    res.positions = warped;
-  } else {
-    res.positions = reconstruct(warped, before, x, stretch, anchored_kept, st.anchored > st.anchored_followed);
-  }
-  std::vector<std::uint8_t> kept_vertex;
-  if (options_.keep_near_vertices && n > 0) {
-    kept_vertex = keep_near_vertices(warped, before, body_distance, distance, res.positions);
-    st.vertices_kept = std::accumulate(kept_vertex.begin(), kept_vertex.end(), std::size_t{0});
-  }
-  if (options_.snap_to_features && !near_feature_.empty() && nf > 0 && !feature_attachment_.vertex.empty()) {
-    const FeatureSnapReport snap = snap_to_features(res.positions, targets, feature_attachment_, reach_, reach_weight_,
-                                                    feature_of_, kept_vertex, options_.snap_regularisation);
-    st.feature_gap_before_snap = snap.gap_before;
-    st.feature_gap = snap.gap_after;
-    st.vertices_snapped = snap.vertices_moved;
-  }
-  res.agents = std::move(x);
-  st.ms.reconstruct = clock.ms();
-  return res;
+  if (n > 0) sol.rotation = rotations(before, x, stretch);
+  if (options_.emit_from_original && !options_.encode_on_warped && st.anchored > st.anchored_followed)
+    sol.keep = std::move(anchored_kept);
+  sol.body_distance = std::move(body_distance);
+  sol.x = std::move(x);
+  return sol;
 }
 
 }  // namespace refit

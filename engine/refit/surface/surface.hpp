@@ -13,10 +13,12 @@
 #include <refit/core/garment.hpp>
 #include <refit/surface/agent_frames.hpp>
 #include <refit/surface/agent_system.hpp>
+#include <refit/surface/agents.hpp>
 #include <refit/surface/coarse_levels.hpp>
 
 #include <functional>
 #include <memory>
+#include <span>
 
 namespace refit {
 
@@ -144,6 +146,48 @@ struct SurfaceSystem {
   Points start;
 };
 
+/// Each vertex's agents within reach and blend weights (bound on the original
+/// garment), for all vertices or a chunk of them (rows in the same order).
+struct VertexBlends {
+  Csr reach;                  // per vertex: its nearest agents within reach (storage slots)
+  std::vector<float> weight;  // smooth_blend: normalised blend weights, parallel to reach.indices
+  std::vector<Index> nearest; // per vertex: nearest agent (used when its reach is empty)
+  std::size_t capped = 0;     // vertices whose agents in reach hit max_reach_agents
+  std::size_t without_agent = 0;
+};
+
+/// The garment's share of a surface binding, found on the original garment:
+/// by SurfaceBinding::bind from a Garment, or chunk by chunk by the chunked
+/// mode (refit/chunked), which then binds with SurfaceBinding::bind_agents.
+struct SurfaceGarmentPart {
+  double voxel = 0.0;
+  bool voxel_auto = false;
+  VoxelGrid grid;
+  std::uint32_t layers = 0;                  // layers of the garment (0 without layers)
+  std::vector<std::uint32_t> feature_layer;  // per feature sample: the layer it sits on
+  GarmentAgents agents;                      // select_agents(garment, grid, feature_skip(...), layers)
+  Points agent_positions;                    // their positions on the original garment
+  std::size_t vertex_count = 0;
+  SurfaceTimings ms;                         // sample and agents
+};
+
+/// The layer of each feature sample: that of the vertex of largest weight of
+/// the face it sits on (all 0 without layers or attachment).
+std::vector<std::uint32_t> feature_layers(std::size_t samples, const SurfaceAttachment& attachment,
+                                          const std::function<std::uint32_t(Index)>& vertex_layer);
+
+/// Voxels (and layers) of the feature samples: their garment agents are dropped.
+std::vector<VoxelLayer> feature_skip(const VoxelGrid& grid, const Points& features,
+                                     const std::vector<std::uint32_t>& feature_layer);
+
+/// Refuses (refit::Error naming the voxel size and the garment's extent) a voxel
+/// size h that would make more than max_agents agents on a garment of this face
+/// area, line length and bounding box extent.
+void check_agent_count(double area, double length, const Vec3& extent, double h, std::size_t max_agents);
+
+/// Checks surface options; throws refit::Error naming the bad one.
+void check_surface_options(const SurfaceOptions& options);
+
 /// The fine solvers of eq. 13 (SurfaceOptions::multigrid and krylov choose apply's).
 enum class FineSolver { sweeps, v_cycles, krylov };
 
@@ -165,6 +209,43 @@ class SurfaceBinding {
   /// feature_samples) when the caller has it already (it is computed otherwise).
   static SurfaceBinding bind(const Garment& original, const Points& feature_samples, const SurfaceOptions& options = {},
                              const SurfaceAttachment* feature_attachment = nullptr);
+
+  /// The binding from the garment's part, without the per-vertex blends
+  /// (vertex_blends gives them a chunk at a time): what bind does after its
+  /// garment passes. `feature_attachment`: where the samples sit on the garment.
+  static SurfaceBinding bind_agents(SurfaceGarmentPart part, const Points& feature_samples,
+                                    const SurfaceOptions& options, SurfaceAttachment feature_attachment);
+
+  /// The blends of vertices at `positions` (original garment) of layers `layer` (per row; empty: all 0).
+  VertexBlends vertex_blends(const Points& positions, std::span<const std::uint32_t> layer) const;
+
+  /// apply's agent part, for apply and the chunked mode: the constraints, the
+  /// solve with its clearance rounds, the anchored agents, the smoothing, and
+  /// the rotations every vertex is re-emitted from.
+  struct AgentSolution {
+    Points before;                         // the agents on the warped garment
+    Points x;                              // their solution
+    std::vector<Eigen::Matrix3d> rotation; // per agent: from the state vertices are re-emitted from to x
+    std::vector<std::uint8_t> keep;        // agents whose vertices are handed back as warped (empty: none)
+    std::vector<double> body_distance;     // per agent: its distance to body B (eq. 14)
+    SurfaceStats stats;
+  };
+  AgentSolution solve_agents(Points before, const Points& feature_targets,
+                             const std::function<double(const Vec3&)>& distance_to_body_b, SurfaceSystem* system) const;
+  /// apply's re-emission of vertices (all, or a chunk: `original` and `warped`
+  /// their rows, `blends` theirs), with eq. 14 for those touching body B
+  /// (`carries_feature`: per row, a corner of a face a feature sample sits on;
+  /// empty without a zone). Adds to out.kept (per row) and the stats.
+  Points emit_vertices(const AgentSolution& solution, const Points& original, const Points& warped,
+                       const VertexBlends& blends, std::span<const std::uint8_t> carries_feature,
+                       const std::function<double(const Vec3&)>& distance_to_body_b, std::vector<std::uint8_t>& kept,
+                       SurfaceStats& stats) const;
+  /// The signed distance to body B that apply(..., body_b, ...) uses (bounded a little beyond epsilon).
+  std::function<double(const Vec3&)> body_distance(const BodySurface& body_b) const;
+  /// Whether the snap to the features runs (snap_to_features, feature_snap.hpp).
+  bool snaps() const;
+  const std::vector<std::int32_t>& feature_of() const { return feature_of_; }
+  const SurfaceAttachment& feature_attachment() const { return feature_attachment_; }
 
   /// With coarse levels, the free agents start from the solution on the next
   /// coarser agent subset (voxel 2h), interpolated: Gauss-Seidel removes smooth
@@ -210,10 +291,16 @@ class SurfaceBinding {
   /// Agent positions on a state of the garment (rows = garment vertices); feature
   /// agents from `feature_positions` (or moved with their nearest vertex when null).
   Points agent_positions(const Points& vertices, const Points* feature_positions) const;
+  /// The garment vertices agent_positions reads (sorted): the garment agents' and the feature samples' attachment.
+  std::vector<Index> agent_vertices() const;
+  /// agent_positions with the position of vertex ids[k] in row k of `vertices` (ids: agent_vertices()).
+  Points agent_positions(const Points& vertices, const std::vector<Index>& ids, const Points* feature_positions) const;
   /// Bind-time statistics (agents, voxel, rings, blocks, bind timings).
   const SurfaceStats& bind_stats() const { return stats_; }
 
  private:
+  template <class Vertex>
+  Points agent_positions_of(const Vertex& vertex, const Points* feature_positions) const;
   // V-cycles on the fine system with aggregation coarse levels (solver.cpp).
   SolveReport solve_multigrid(const AgentRows& rows, const Points& h, const std::vector<std::uint8_t>& free, Points& x,
                               const SolveOptions& solve, bool krylov, int* krylov_iterations) const;
@@ -225,15 +312,11 @@ class SurfaceBinding {
                               const std::vector<std::uint8_t>& fr, Points& x,
                               std::vector<std::uint8_t>& anchored_kept) const;
   void smooth_displacements(const Points& before, const std::vector<std::uint8_t>& fr, Points& x) const;
-  Points reconstruct(const Points& warped, const Points& before, const Points& x,
-                     const std::vector<Eigen::Matrix3d>& stretch,
-                     const std::vector<std::uint8_t>& anchored_kept, bool some_anchored_kept) const;
-  std::vector<std::uint8_t> keep_near_vertices(const Points& warped, const Points& before,
-                                               const std::vector<double>& body_distance,
+  std::vector<Eigen::Matrix3d> rotations(const Points& before, const Points& x, const std::vector<Eigen::Matrix3d>& stretch) const;
+  std::vector<std::uint8_t> keep_near_vertices(const AgentSolution& solution, const Points& warped,
+                                               const VertexBlends& blends, std::span<const std::uint8_t> carries_feature,
                                                const std::function<double(const Vec3&)>& distance,
                                                Points& positions) const;
-  // Each vertex's agents within reach and blend weights (bind; reconstruct.cpp).
-  void bind_vertex_blends(const Points& positions, const std::vector<std::uint32_t>& vertex_layer);
 
   SurfaceOptions options_;
   double h_ = 0.0;
@@ -255,9 +338,7 @@ class SurfaceBinding {
   BlockSchedule schedule_;
   std::vector<Index> group_;         // connected group of each agent (one-ring graph)
   std::size_t groups_ = 0;
-  Csr reach_;                        // per garment vertex: its nearest agents within reach
-  std::vector<float> reach_weight_;  // smooth_blend: normalised blend weights, parallel to reach_.indices
-  std::vector<Index> nearest_;       // per garment vertex: nearest agent (used when reach is empty)
+  VertexBlends blends_;              // per garment vertex (bind; empty from bind_agents)
   Points original_vertices_;         // emit_from_original: the garment's original positions
   std::vector<CoarseLevel> levels_;  // coarser levels, finest first (coarse_levels.hpp)
   SurfaceStats stats_;
