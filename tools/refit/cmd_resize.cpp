@@ -4,6 +4,7 @@
 #include "manifest.hpp"
 #include "report_file.hpp"
 
+#include <refit/chunked/chunked_resize.hpp>
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
 #include <refit/io/atomic_file.hpp>
@@ -24,6 +25,8 @@ namespace {
 struct ResizeArgs {
   std::string garment, from, out, out_dir, report, features, curves_out, units = "cm", stage = "full", symmetry, method = "refit";
   std::string to_list, shard;
+  std::string memory_budget, temp_dir;
+  std::size_t chunk_vertices = 0;
   std::vector<std::string> to;
   std::vector<std::string> to_outputs;  // with --to-list: the output of each body of `to`
   std::size_t threads = 0, max_triangles = WarpOptions{}.max_triangles;
@@ -85,6 +88,71 @@ void take_manifest(ResizeArgs& a) {
     if (!folder.empty()) std::filesystem::create_directories(folder, ec);
     if (ec) throw input_error(r.output, "cannot create its folder: " + ec.message());
   }
+}
+
+// The chunked mode's run (issue 14): the same outputs and report as run()'s in-memory path.
+int run_chunked(const ResizeArgs& a, const ResizeOptions& options, ObjStream obj, const ChunkPlan& plan,
+                const Progress& progress, Stopwatch& total) {
+  Stopwatch clock;
+  progress.stage("reading " + a.garment + " into " + plan.folder.string() + " (chunks of " +
+                 std::to_string(plan.chunk_vertices) + " vertices, about " + std::to_string(int(plan.estimate_mb)) + " MB)");
+  obj.set_group_bytes(plan.group_bytes);
+  auto store = std::make_shared<const GarmentStore>(std::move(obj), plan.folder);
+  BodyMesh body_a = read_body(a.from);
+  const double load_ms = clock.ms();
+  std::vector<FeatureSpec> features;
+  if (!a.features.empty()) features = read_feature_file(a.features, a.units);
+  ResizeOptions o = options;
+  if (a.no_shape_control) o.stage = Stage::Warp;
+  const ChunkedBinding binding(store, std::move(body_a), o, std::move(features), plan, progress);
+  std::optional<OutputBatch> all_outputs;
+  if (a.to.size() == 1) all_outputs.emplace();
+  nlohmann::json reports = nlohmann::json::array();
+  std::size_t failed = 0;
+  for (const std::string& to : a.to) {
+    try {
+      OutputBatch body_outputs;
+      clock.reset();
+      const BodyMesh body_b = read_body(to);
+      const double load_b_ms = clock.ms();
+      const std::string out = a.out_dir.empty() ? a.out : (std::filesystem::path(a.out_dir) / (body_b.name + ".obj")).string();
+      ChunkedResult result = binding.resize(body_b, out, progress);
+      if (!a.curves_out.empty()) write_curves_obj(a.curves_out, result.features);
+      nlohmann::json& r = result.report;
+      r["timings_ms"]["load"] = load_ms + load_b_ms;
+      r["timings_ms"]["bind"] = binding.bind_report();
+      r["timings_ms"]["total"] = total.ms();
+      for (const auto& w : store->warnings()) result.warnings.push_back(w);
+      r["version"] = kVersion;
+      r["garment"] = store->summary();
+      r["garment"]["file"] = a.garment;
+      r["body_a"] = a.from;
+      r["body_b"] = to;
+      r["output"] = out;
+      r["units"] = a.units;
+      r["peak_memory_mb"] = peak_memory_mb();
+      r["warnings"] = result.warnings;
+      reports.push_back(r);
+      body_outputs.commit();
+      progress.stage("wrote " + out);
+      total.reset();
+    } catch (const Error& e) {
+      if (a.to.size() == 1) throw;
+      ++failed;
+      std::fprintf(stderr, "refit: error: %s (body skipped)\n", e.what());
+      reports.push_back({{"body_b", to}, {"error", e.what()}});
+    }
+  }
+  if (!a.report.empty()) {
+    nlohmann::json doc = reports.size() == 1 ? reports[0] : nlohmann::json{{"version", kVersion}, {"bodies", reports}};
+    write_json_report(a.report, doc);
+  }
+  if (all_outputs) all_outputs->commit();
+  if (failed > 0) {
+    std::fprintf(stderr, "refit: %zu of %zu bodies failed\n", failed, a.to.size());
+    return 4;
+  }
+  return 0;
 }
 
 int run(ResizeArgs a) {
@@ -152,6 +220,18 @@ int run(ResizeArgs a) {
   check_outputs(ins, outs);
 
   Stopwatch clock;
+  // Issue 14: above the memory budget (or with --chunk-vertices) the garment is
+  // resized in chunks, streamed from and to disk.
+  ChunkOptions chunking;
+  if (!a.memory_budget.empty()) chunking.memory_budget = parse_size(a.memory_budget, "--memory-budget");
+  chunking.chunk_vertices = a.chunk_vertices;
+  chunking.temp_folder = a.temp_dir;
+  if (chunking.memory_budget > 0 || chunking.chunk_vertices > 0) {
+    progress.stage("counting " + a.garment);
+    ObjStream obj(a.garment);
+    const GarmentSize size{obj.bytes(), obj.vertex_count(), obj.face_count()};
+    if (use_chunks(size, chunking)) return run_chunked(a, options, std::move(obj), plan_chunks(size, chunking), progress, total);
+  }
   progress.stage("reading " + a.garment);
   auto garment = std::make_shared<const Garment>(read_garment_obj(a.garment));
   BodyMesh body_a = read_body(a.from);
@@ -314,6 +394,13 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
       ->check(check_clearance)
       ->capture_default_str();
   app.add_flag("--metrics", a->metrics, "Add fit, penetration and surface metrics of the warp and the result to the report");
+  app.add_option("--memory-budget", a->memory_budget,
+                 "Memory a run may use (e.g. 800M, 1G): above it the garment is resized in chunks streamed from and to "
+                 "disk, with the same output (docs/chunked.md)");
+  app.add_option("--chunk-vertices", a->chunk_vertices, "Resize in chunks of this many vertices (testing the chunked mode)")
+      ->check(CLI::Range(std::size_t(1), std::size_t(1) << 40))
+      ->group(kAdvanced);
+  app.add_option("--temp-dir", a->temp_dir, "Folder for the chunked mode's temporary files (default: the system's)");
   app.add_flag("--quiet", a->quiet, "No progress on stderr");
   return [a]() { return run(*a); };
 });

@@ -1,0 +1,315 @@
+#include <refit/chunked/chunked_symmetry.hpp>
+
+#include <refit/attach/attachment.hpp>
+#include <refit/core/error.hpp>
+#include <refit/features/symmetry.hpp>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <queue>
+
+namespace refit {
+namespace {
+
+struct Query {
+  Index vertex;
+  std::array<double, 3> p;
+};
+
+struct Result {
+  Index vertex;
+  MirrorRecord record;
+};
+
+// Records appended to a temporary file through a buffer, read back in order.
+template <class T>
+class Spool {
+ public:
+  explicit Spool(const std::filesystem::path& folder) : file_(folder) {}
+  void push(const T& t) {
+    buffer_.push_back(t);
+    if (buffer_.size() >= 4096) flush();
+  }
+  void flush() {
+    file_.append(buffer_.data(), buffer_.size() * sizeof(T));
+    count_ += buffer_.size();
+    buffer_.clear();
+  }
+  std::size_t size() const { return count_ + buffer_.size(); }
+  // Items [first, first + n) (after flush()).
+  void read(std::size_t first, std::size_t n, std::vector<T>& out) const {
+    out.resize(n);
+    file_.read(out.data(), n * sizeof(T), first * sizeof(T));
+  }
+
+ private:
+  TempFile file_;
+  std::vector<T> buffer_;
+  std::size_t count_ = 0;
+};
+
+// A slab's elements, in element order: per row its kind (0 face, 1 line, 2 point) and corners.
+struct SlabElements {
+  explicit SlabElements(const std::filesystem::path& folder) : words(folder) {}
+  Spool<Index> words;  // kind, size, corners... per row
+};
+
+// The k-th smallest (0-based) of non-negative doubles on disk, by their bits (radix selection, 16 bits a pass).
+double kth_smallest(const Spool<double>& values, std::size_t k) {
+  std::uint64_t prefix = 0;
+  std::vector<double> chunk;
+  for (int shift = 48; shift >= 0; shift -= 16) {
+    const std::uint64_t mask = shift == 48 ? 0 : ~std::uint64_t(0) << (shift + 16);
+    std::vector<std::size_t> count(1 << 16, 0);
+    for (std::size_t first = 0; first < values.size(); first += 1 << 20) {
+      values.read(first, std::min<std::size_t>(1 << 20, values.size() - first), chunk);
+      for (double d : chunk) {
+        const std::uint64_t b = std::bit_cast<std::uint64_t>(d);
+        if ((b & mask) == prefix) ++count[(b >> shift) & 0xffff];
+      }
+    }
+    std::size_t bin = 0;
+    while (k >= count[bin]) k -= count[bin++];
+    prefix |= std::uint64_t(bin) << shift;
+  }
+  return std::bit_cast<double>(prefix);
+}
+
+}  // namespace
+
+double MirrorRecord::distance() const {
+  return Eigen::RowVector3d(offset[0], offset[1], offset[2]).norm();
+}
+
+ChunkedMirror chunked_mirror_attach(const GarmentStore& g, const PointGather& x, const ChunkPlan& plan, double plane_x,
+                                    double radius) {
+  const std::filesystem::path& folder = plan.folder;
+  const std::size_t n = g.vertex_count();
+  ChunkedMirror out{RecordFile<MirrorRecord>(folder), 0.0, 0};
+  // Slabs along the longest axis of the garment and of its mirror image.
+  Vec3 low = g.low(), high = g.high();
+  low.x() = std::min(low.x(), 2.0 * plane_x - g.high().x());
+  high.x() = std::max(high.x(), 2.0 * plane_x - g.low().x());
+  int axis = 0;
+  for (int a = 1; a < 3; ++a)
+    if (high[a] - low[a] > high[axis] - low[axis]) axis = a;
+  const double diagonal = (high - low).norm();
+  const bool bare = g.face_count() + g.line_count() + g.point_count() == 0;
+  const std::size_t elements = bare ? n : g.face_count() + g.line_count() + g.point_count();
+  const std::size_t slabs = std::max<std::size_t>(1, (2 * elements + plan.chunk_faces - 1) / std::max<std::size_t>(plan.chunk_faces, 1));
+  const double width = std::max(high[axis] - low[axis], 1e-300) / double(slabs);
+  const auto slab_of = [&](double v) {
+    return std::min<std::size_t>(slabs - 1, static_cast<std::size_t>(std::max(0.0, (v - low[axis]) / width)));
+  };
+
+  // Round 0 asks for every vertex's image; each round the images not found
+  // within the radius ask again with four times the radius.
+  auto pending = std::make_unique<Spool<Query>>(folder);
+  for_each_chunk(g.positions(), plan.chunk_vertices, [&](std::size_t first, const Points& rows) {
+    for (Eigen::Index i = 0; i < rows.rows(); ++i)
+      pending->push({Index(first + std::size_t(i)), {2.0 * plane_x - rows(i, 0), rows(i, 1), rows(i, 2)}});
+  });
+  pending->flush();
+  std::vector<std::unique_ptr<Spool<Result>>> results;  // per round and slab, each in vertex order
+  Spool<double> distances(folder);                     // of the images found
+  const std::size_t rank = percentile95_rank(n);
+  double r = std::max(radius, 1e-6 * diagonal);
+  for (;; r *= 4.0, ++out.rounds) {
+    const bool everything = r >= 2.0 * diagonal;  // every element reaches every slab: all found
+    // This round's queries and elements, by slab.
+    std::vector<std::unique_ptr<Spool<Query>>> queries;
+    std::vector<std::unique_ptr<SlabElements>> slab_elements;
+    for (std::size_t s = 0; s < slabs; ++s) {
+      queries.push_back(std::make_unique<Spool<Query>>(folder));
+      slab_elements.push_back(std::make_unique<SlabElements>(folder));
+    }
+    std::vector<Query> q;
+    for (std::size_t first = 0; first < pending->size(); first += 1 << 16) {
+      pending->read(first, std::min<std::size_t>(1 << 16, pending->size() - first), q);
+      for (const Query& query : q) queries[slab_of(query.p[std::size_t(axis)])]->push(query);
+    }
+    const auto distribute = [&](const CsrFile& file, Index kind) {
+      for_each_block(file, plan.chunk_faces, x, [&](const ElementBlock& b) {
+        for (std::size_t e = 0; e < b.rows.rows(); ++e) {
+          double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+          for (std::size_t c = b.rows.offsets[e]; c < b.rows.offsets[e + 1]; ++c) {
+            lo = std::min(lo, b.corner(c)[axis]);
+            hi = std::max(hi, b.corner(c)[axis]);
+          }
+          const std::size_t s0 = everything ? 0 : slab_of(lo - r * 1.000001), s1 = everything ? slabs - 1 : slab_of(hi + r * 1.000001);
+          for (std::size_t s = s0; s <= s1; ++s) {
+            Spool<Index>& w = slab_elements[s]->words;
+            w.push(kind);
+            w.push(Index(b.rows.row_size(e)));
+            for (Index v : b.rows.row(e)) w.push(v);
+          }
+        }
+      });
+    };
+    if (bare) {
+      // A garment without elements attaches to its vertices (as GarmentLocator does).
+      CsrFile points(folder);
+      for (std::size_t first = 0; first < n; first += plan.chunk_vertices) {
+        Csr rows;
+        for (std::size_t i = first; i < std::min(n, first + plan.chunk_vertices); ++i) {
+          const Index v = Index(i);
+          rows.push_row(std::span<const Index>(&v, 1));
+        }
+        points.append(rows);
+      }
+      distribute(points, 2);
+    } else {
+      distribute(g.faces(), 0);
+      distribute(g.lines(), 1);
+      distribute(g.points(), 2);
+    }
+    auto next = std::make_unique<Spool<Query>>(folder);
+    std::vector<Index> words, ids;
+    std::vector<Query> slab_queries;
+    for (std::size_t s = 0; s < slabs; ++s) {
+      queries[s]->flush();
+      SlabElements& se = *slab_elements[s];
+      se.words.flush();
+      auto found = std::make_unique<Spool<Result>>(folder);
+      if (queries[s]->size() == 0) continue;
+      queries[s]->read(0, queries[s]->size(), slab_queries);
+      // The slab's elements as a garment of their own, in element order.
+      se.words.read(0, se.words.size(), words);
+      Garment sub;
+      ids.clear();
+      for (std::size_t w = 0; w < words.size(); w += 2 + words[w + 1]) ids.insert(ids.end(), words.begin() + std::ptrdiff_t(w + 2), words.begin() + std::ptrdiff_t(w + 2 + words[w + 1]));
+      std::sort(ids.begin(), ids.end());
+      ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+      const auto local = [&](Index v) { return Index(std::lower_bound(ids.begin(), ids.end(), v) - ids.begin()); };
+      std::vector<Index> row;
+      for (std::size_t w = 0; w < words.size(); w += 2 + words[w + 1]) {
+        row.clear();
+        for (std::size_t c = 0; c < words[w + 1]; ++c) row.push_back(local(words[w + 2 + c]));
+        (words[w] == 0 ? sub.faces : words[w] == 1 ? sub.lines : sub.points).push_row(row);
+      }
+      std::vector<Index>().swap(words);
+      if (sub.faces.rows() + sub.lines.rows() + sub.points.rows() == 0) {
+        for (const Query& query : slab_queries) next->push(query);
+        continue;
+      }
+      x.gather(ids, sub.positions);
+      Points p(Eigen::Index(slab_queries.size()), 3);
+      for (std::size_t k = 0; k < slab_queries.size(); ++k)
+        p.row(Eigen::Index(k)) << slab_queries[k].p[0], slab_queries[k].p[1], slab_queries[k].p[2];
+      const SurfaceAttachment at = GarmentLocator(sub).attach(p);
+      // Found: closer than the radius less a margin for rounding (an element
+      // left out of the slab is farther than the radius).
+      const double sure = r * (1.0 - 1e-9) - 1e-12 * diagonal;
+      for (std::size_t k = 0; k < slab_queries.size(); ++k) {
+        MirrorRecord m;
+        for (int j = 0; j < 3; ++j) {
+          m.vertex[j] = ids[at.vertex[k][j]];
+          m.weight[j] = at.weight[k][j];
+          m.offset[j] = at.offset(Eigen::Index(k), j);
+        }
+        const double d = m.distance();
+        if (everything || d <= sure) {
+          found->push({slab_queries[k].vertex, m});
+          distances.push(d);
+        } else {
+          next->push(slab_queries[k]);
+        }
+      }
+      found->flush();
+      results.push_back(std::move(found));
+    }
+    next->flush();
+    distances.flush();
+    pending = std::move(next);
+    if (pending->size() == 0 || distances.size() > rank) break;
+  }
+  // The rest were never found: no partner (an infinite distance).
+  {
+    auto rest = std::make_unique<Spool<Result>>(folder);
+    std::vector<Query> q;
+    MirrorRecord none;
+    none.offset.fill(std::numeric_limits<double>::infinity());
+    std::vector<Result> sorted;
+    for (std::size_t first = 0; first < pending->size(); first += 1 << 16) {
+      pending->read(first, std::min<std::size_t>(1 << 16, pending->size() - first), q);
+      for (const Query& query : q) sorted.push_back({query.vertex, none});
+    }
+    std::sort(sorted.begin(), sorted.end(), [](const Result& a, const Result& b) { return a.vertex < b.vertex; });
+    for (const Result& res : sorted) rest->push(res);
+    rest->flush();
+    results.push_back(std::move(rest));
+  }
+  out.garment_error = n == 0 ? 0.0 : kth_smallest(distances, rank);
+  // Every vertex's record, merged from the rounds' and slabs' lists (each in vertex order).
+  struct Cursor {
+    const Spool<Result>* spool;
+    std::size_t next = 0;
+    std::vector<Result> buffer;
+    std::size_t at = 0;
+    bool fill() {
+      if (at < buffer.size()) return true;
+      if (next >= spool->size()) return false;
+      spool->read(next, std::min<std::size_t>(1 << 12, spool->size() - next), buffer);
+      next += buffer.size();
+      at = 0;
+      return true;
+    }
+  };
+  std::vector<Cursor> cursors;
+  for (const auto& r : results) cursors.push_back({r.get(), 0, {}, 0});
+  const auto later = [&](std::size_t a, std::size_t b) {
+    return cursors[a].buffer[cursors[a].at].vertex > cursors[b].buffer[cursors[b].at].vertex;
+  };
+  std::priority_queue<std::size_t, std::vector<std::size_t>, decltype(later)> heap(later);
+  for (std::size_t c = 0; c < cursors.size(); ++c)
+    if (cursors[c].fill()) heap.push(c);
+  std::vector<MirrorRecord> block;
+  std::size_t written = 0;
+  while (!heap.empty()) {
+    const std::size_t c = heap.top();
+    heap.pop();
+    Cursor& cur = cursors[c];
+    if (cur.buffer[cur.at].vertex != written) throw Error("internal: the mirror images do not cover every vertex once");
+    block.push_back(cur.buffer[cur.at].record);
+    ++written;
+    ++cur.at;
+    if (cur.fill()) heap.push(c);
+    if (block.size() == 1 << 14 || heap.empty()) {
+      out.records.write(written - block.size(), std::span<const MirrorRecord>(block));
+      block.clear();
+    }
+  }
+  if (written != n) throw Error("internal: the mirror images do not cover every vertex");
+  return out;
+}
+
+Points symmetrised_rows(const RecordFile<MirrorRecord>& mirror, const PointGather& positions, std::size_t first,
+                        const Points& s, double plane_x, double tolerance) {
+  std::vector<MirrorRecord> rec;
+  mirror.read(first, std::size_t(s.rows()), rec);
+  std::vector<Index> ids;
+  for (const MirrorRecord& m : rec)
+    if (m.distance() <= tolerance) ids.insert(ids.end(), m.vertex.begin(), m.vertex.end());
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  Points p;
+  positions.gather(ids, p);
+  Points out = s;
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    const MirrorRecord& m = rec[i];
+    if (!(m.distance() <= tolerance)) continue;
+    // carry_one's sum, then mirror_x.
+    Vec3 q(m.offset[0], m.offset[1], m.offset[2]);
+    for (int k = 0; k < 3; ++k)
+      q += m.weight[k] * row3(p, Index(std::lower_bound(ids.begin(), ids.end(), m.vertex[k]) - ids.begin()));
+    Eigen::RowVector3d mirrored(q.x(), q.y(), q.z());
+    mirrored(0) = (2.0 * plane_x) - q.x();
+    out.row(Eigen::Index(i)) = 0.5 * (s.row(Eigen::Index(i)) + mirrored);
+  }
+  return out;
+}
+
+}  // namespace refit
