@@ -4,6 +4,7 @@
 // budget even the chunks cannot fit are refused before any work.
 #include <refit/chunked/chunk_plan.hpp>
 #include <refit/core/error.hpp>
+#include <refit/pipeline/input_checks.hpp>
 
 #include "support/test_support.hpp"
 
@@ -65,17 +66,18 @@ TEST(ChunkPlan, ChunksAboveTheInMemoryEstimateWithinTheBudget) {
   const GarmentSize dress{2'800'000'000, 17'177'471, 34'340'864};
   ChunkOptions o;
   o.memory_budget = std::size_t(1) << 30;
-  EXPECT_GT(in_memory_estimate_mb(dress), 1024.0);
-  EXPECT_TRUE(use_chunks(dress, o));
+  const double dress_mb = estimated_memory_mb(dress.vertices, 20000, 26756);
+  EXPECT_GT(dress_mb, 1024.0);
+  EXPECT_TRUE(use_chunks(dress, o, dress_mb));
   const ChunkPlan p = plan_chunks(dress, o);
   EXPECT_LE(p.estimate_mb, 1024.0);
   EXPECT_GE(p.chunk_vertices, 100000u);
   // The 1M dense dress in 4 GB: in memory.
   o.memory_budget = std::size_t(4) << 30;
-  EXPECT_FALSE(use_chunks({143'612'458, 1'074'911, 2'146'304}, o));
+  EXPECT_FALSE(use_chunks({143'612'458, 1'074'911, 2'146'304}, o, estimated_memory_mb(1'074'911, 20000, 26756)));
   // Forced, with chunks of 100 vertices.
   o.chunk_vertices = 100;
-  EXPECT_TRUE(use_chunks({1000, 10, 10}, o));
+  EXPECT_TRUE(use_chunks({1000, 10, 10}, o, 31.0));
   EXPECT_EQ(plan_chunks({1000, 10, 10}, o).chunk_vertices, 100u);
   EXPECT_EQ(parse_size("800M", "x"), std::size_t(800) << 20);
   EXPECT_EQ(parse_size("1G", "x"), std::size_t(1) << 30);

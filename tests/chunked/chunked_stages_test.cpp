@@ -100,7 +100,10 @@ TEST(ChunkedStages, WeldLayersAgentsAttachmentsAndSlicesAreTheInMemoryOnes) {
 
       SurfaceOptions o;
       const double h = surface_voxel(g, o);
-      EXPECT_EQ(std::bit_cast<std::uint64_t>(chunked_surface_voxel(*s.store, x, s.plan, o)), std::bit_cast<std::uint64_t>(h));
+      const auto measure = chunked_surface_measure(*s.store, x, s.plan), expected = surface_measure(g);
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(measure.first), std::bit_cast<std::uint64_t>(expected.first));
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(measure.second), std::bit_cast<std::uint64_t>(expected.second));
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(chunked_surface_voxel(*s.store, measure, o)), std::bit_cast<std::uint64_t>(h));
       const std::vector<std::uint32_t> layers = surface_layers(g, o, h);
       EXPECT_EQ(chunked_layers(*s.store, x, s.plan, o.layer_min_area * h * h, o.layer_join * h), layers);
 

@@ -90,70 +90,92 @@ void take_manifest(ResizeArgs& a) {
   }
 }
 
-// The chunked mode's run (issue 14): the same outputs and report as run()'s in-memory path.
-int run_chunked(const ResizeArgs& a, const ResizeOptions& options, ObjStream obj, const ChunkPlan& plan,
-                const Progress& progress, Stopwatch& total) {
-  Stopwatch clock;
-  progress.stage("reading " + a.garment + " into " + plan.folder.string() + " (chunks of " +
-                 std::to_string(plan.chunk_vertices) + " vertices, about " + std::to_string(int(plan.estimate_mb)) + " MB)");
-  obj.set_group_bytes(plan.group_bytes);
-  auto store = std::make_shared<const GarmentStore>(std::move(obj), plan.folder);
-  BodyMesh body_a = read_body(a.from);
-  const double load_ms = clock.ms();
-  std::vector<FeatureSpec> features;
-  if (!a.features.empty()) features = read_feature_file(a.features, a.units);
-  ResizeOptions o = options;
-  if (a.no_shape_control) o.stage = Stage::Warp;
-  const ChunkedBinding binding(store, std::move(body_a), o, std::move(features), plan, progress);
-  std::optional<OutputBatch> all_outputs;
-  if (a.to.size() == 1) all_outputs.emplace();
-  nlohmann::json reports = nlohmann::json::array();
-  std::size_t failed = 0;
-  for (const std::string& to : a.to) {
-    try {
-      OutputBatch body_outputs;
-      clock.reset();
-      const BodyMesh body_b = read_body(to);
-      const double load_b_ms = clock.ms();
-      const std::string out = a.out_dir.empty() ? a.out : (std::filesystem::path(a.out_dir) / (body_b.name + ".obj")).string();
-      ChunkedResult result = binding.resize(body_b, out, progress);
-      if (!a.curves_out.empty()) write_curves_obj(a.curves_out, result.features);
-      nlohmann::json& r = result.report;
-      r["timings_ms"]["load"] = load_ms + load_b_ms;
-      r["timings_ms"]["bind"] = binding.bind_report();
-      r["timings_ms"]["total"] = total.ms();
-      for (const auto& w : store->warnings()) result.warnings.push_back(w);
-      r["version"] = kVersion;
-      r["garment"] = store->summary();
-      r["garment"]["file"] = a.garment;
-      r["body_a"] = a.from;
-      r["body_b"] = to;
-      r["output"] = out;
-      r["units"] = a.units;
-      r["peak_memory_mb"] = peak_memory_mb();
-      r["warnings"] = result.warnings;
-      reports.push_back(r);
-      body_outputs.commit();
-      progress.stage("wrote " + out);
-      total.reset();
-    } catch (const Error& e) {
-      if (a.to.size() == 1) throw;
-      ++failed;
-      std::fprintf(stderr, "refit: error: %s (body skipped)\n", e.what());
-      reports.push_back({{"body_b", to}, {"error", e.what()}});
+// One body's resize: its report and warnings, and what writing its garment said.
+struct BodyResult {
+  nlohmann::json report;
+  std::vector<std::string> warnings;
+  ObjWriteReport written;
+  FeatureResult features;
+};
+
+// What the in-memory and the chunked modes share: the bodies one after another,
+// their outputs, warnings and reports.
+struct Run {
+  const ResizeArgs& a;
+  bool batch;  // a failed body is skipped, exit 4
+  const std::vector<std::string>& outs;
+  const Progress& progress;
+  Stopwatch& total;
+  nlohmann::json garment;                 // the report's garment object
+  std::vector<std::string> garment_warnings;
+  double load_ms = 0.0;
+  nlohmann::json bind_report;
+
+  int bodies(const std::function<BodyResult(const BodyMesh& body_b, const std::string& out)>& resize,
+             std::optional<OutputFolder>& folder) const {
+    // Every output of the run appears together at its end, or none (a body that
+    // fails in a batch is skipped: its files never appear).
+    OutputBatch all_outputs;
+    nlohmann::json reports = nlohmann::json::array();
+    std::size_t failed = 0;
+    Stopwatch clock;
+    for (std::size_t body = 0; body < a.to.size(); ++body) {
+      const std::string& to = a.to[body];
+      const std::string& out = outs[body];
+      try {
+        OutputBatch body_outputs;
+        clock.reset();
+        const BodyMesh body_b = read_body(to);
+        const double load_b_ms = clock.ms();
+        BodyResult result = resize(body_b, out);
+        if (!a.curves_out.empty()) write_curves_obj(a.curves_out, result.features);
+        nlohmann::json& r = result.report;
+        r["timings_ms"]["load"] = load_ms + load_b_ms;
+        r["timings_ms"]["bind"] = bind_report;
+        r["timings_ms"]["total"] = total.ms();
+        // On stderr too (not only in the report), naming the body or the output.
+        for (const auto& w : result.warnings) std::fprintf(stderr, "refit: warning: %s: %s\n", to.c_str(), w.c_str());
+        for (const auto& w : result.written.warnings) {
+          std::fprintf(stderr, "refit: warning: %s: %s\n", out.c_str(), w.c_str());
+          result.warnings.push_back(w);
+        }
+        if (result.written.normals_recomputed > 0)  // what the writer always does: the report says how many
+          result.warnings.push_back(std::to_string(result.written.normals_recomputed) +
+                                    " vn normals recomputed from the new positions");
+        for (const auto& w : garment_warnings) result.warnings.push_back(w);
+        r["version"] = kVersion;
+        r["garment"] = garment;
+        r["garment"]["file"] = a.garment;
+        r["body_a"] = a.from;
+        r["body_b"] = to;
+        r["output"] = out;
+        r["units"] = a.units;
+        r["peak_memory_mb"] = peak_memory_mb();
+        r["warnings"] = result.warnings;
+        reports.push_back(r);
+        body_outputs.commit();
+        progress.stage("done " + out);
+        total.reset();
+      } catch (const Error& e) {
+        if (!batch) throw;
+        ++failed;
+        std::fprintf(stderr, "refit: error: %s (body skipped)\n", e.what());
+        reports.push_back({{"body_b", to}, {"error", e.what()}});
+      }
     }
+    if (!a.report.empty()) {
+      nlohmann::json doc = !batch ? reports[0] : nlohmann::json{{"version", kVersion}, {"bodies", reports}};
+      write_json_report(a.report, doc);
+    }
+    all_outputs.commit();
+    if (folder) folder->keep();
+    if (failed > 0) {
+      std::fprintf(stderr, "refit: %zu of %zu bodies failed\n", failed, a.to.size());
+      return 4;
+    }
+    return 0;
   }
-  if (!a.report.empty()) {
-    nlohmann::json doc = reports.size() == 1 ? reports[0] : nlohmann::json{{"version", kVersion}, {"bodies", reports}};
-    write_json_report(a.report, doc);
-  }
-  if (all_outputs) all_outputs->commit();
-  if (failed > 0) {
-    std::fprintf(stderr, "refit: %zu of %zu bodies failed\n", failed, a.to.size());
-    return 4;
-  }
-  return 0;
-}
+};
 
 int run(ResizeArgs a) {
   Stopwatch total;
@@ -220,93 +242,78 @@ int run(ResizeArgs a) {
   check_outputs(ins, outs);
 
   Stopwatch clock;
-  // Issue 14: above the memory budget (or with --chunk-vertices) the garment is
-  // resized in chunks, streamed from and to disk.
+  // --memory-budget: the in-memory run's limit too. Above it (or above this
+  // machine's memory without one), or with --chunk-vertices, the garment is
+  // resized in chunks streamed from and to disk (issue 14, docs/chunked.md).
   ChunkOptions chunking;
   if (!a.memory_budget.empty()) chunking.memory_budget = parse_size(a.memory_budget, "--memory-budget");
   chunking.chunk_vertices = a.chunk_vertices;
   chunking.temp_folder = a.temp_dir;
-  if (chunking.memory_budget > 0 || chunking.chunk_vertices > 0) {
-    progress.stage("counting " + a.garment);
-    ObjStream obj(a.garment);
-    const GarmentSize size{obj.bytes(), obj.vertex_count(), obj.face_count()};
-    if (use_chunks(size, chunking)) return run_chunked(a, options, std::move(obj), plan_chunks(size, chunking), progress, total);
-  }
-  progress.stage("reading " + a.garment);
-  auto garment = std::make_shared<const Garment>(read_garment_obj(a.garment));
+  options.memory_budget_mb = double(chunking.memory_budget) / (1024.0 * 1024.0);
+  if (a.no_shape_control) options.stage = Stage::Warp;
+  Run run{a, batch, outs, progress, total, {}, {}, 0.0, {}};
   BodyMesh body_a = read_body(a.from);
   check_human_size(body_a, units_per_cm(a.units));
-  const double load_ms = clock.ms();
-  const std::vector<std::string> garment_warnings = garment->source ? garment->source->warnings : std::vector<std::string>{};
-  for (const auto& w : garment_warnings) std::fprintf(stderr, "refit: warning: %s\n", w.c_str());
+  std::optional<ObjStream> obj;
+  GarmentSize size;
+  // The garment's sizes from its first pass when the choice needs them (a
+  // budget, or a file large enough that the in-memory run might not fit).
+  std::error_code size_error;
+  const std::size_t file_bytes = std::filesystem::file_size(a.garment, size_error);
+  if (chunking.memory_budget > 0 || chunking.chunk_vertices > 0 || (!size_error && might_exceed_memory(file_bytes))) {
+    progress.stage("counting " + a.garment);
+    obj.emplace(a.garment);
+    size = {obj->bytes(), obj->vertex_count(), obj->face_count()};
+  }
+  SurfaceOptions so = options.surface;
+  so.voxel *= units_per_cm(options.units);
+  const double in_memory_mb =
+      estimated_memory_mb(size.vertices, options.stage == Stage::Full ? estimated_agents(size.vertices, so.agent_budget, so.voxel) : 0.0,
+                          body_a.triangles.size());
+  if (obj && use_chunks(size, chunking, in_memory_mb)) {
+    check_chunked_options(options);
+    const ChunkPlan plan = plan_chunks(size, chunking);
+    progress.stage("reading " + a.garment + " into " + plan.folder.string() + " in chunks of " +
+                   std::to_string(plan.chunk_vertices) + " vertices (about " + std::to_string(int(plan.estimate_mb)) +
+                   " MB in all)");
+    obj->set_group_bytes(plan.group_bytes);
+    auto store = std::make_shared<const GarmentStore>(std::move(*obj), plan.folder);
+    run.load_ms = clock.ms();
+    run.garment = store->summary();
+    run.garment_warnings = store->warnings();
+    for (const auto& w : run.garment_warnings) std::fprintf(stderr, "refit: warning: %s\n", w.c_str());
+    std::vector<FeatureSpec> features;
+    if (!a.features.empty()) features = read_feature_file(a.features, a.units);
+    const ChunkedBinding binding(store, std::move(body_a), options, std::move(features), plan, progress);
+    run.bind_report = binding.bind_report();
+    return run.bodies(
+        [&](const BodyMesh& body_b, const std::string& out) {
+          ChunkedResult r = binding.resize(body_b, out, progress);
+          return BodyResult{std::move(r.report), std::move(r.warnings), std::move(r.written), std::move(r.features)};
+        },
+        folder);
+  }
+  progress.stage("reading " + a.garment);
+  obj.reset();
+  auto garment = std::make_shared<const Garment>(read_garment_obj(a.garment));
+  run.load_ms = clock.ms();
+  run.garment = garment_summary(*garment);
+  run.garment_warnings = garment->source ? garment->source->warnings : std::vector<std::string>{};
+  for (const auto& w : run.garment_warnings) std::fprintf(stderr, "refit: warning: %s\n", w.c_str());
   std::vector<FeatureSpec> features;
   if (!a.features.empty()) features = read_feature_file(a.features, a.units);
-  if (a.no_shape_control) options.stage = Stage::Warp;
   const GarmentBinding binding(garment, std::move(body_a), options, std::move(features), progress);
-
-  // Every output of the run appears together at its end, or none (a body that
-  // fails in a batch is skipped: its files never appear).
-  OutputBatch all_outputs;
-  nlohmann::json reports = nlohmann::json::array();
-  std::size_t failed = 0;
-  for (std::size_t body = 0; body < a.to.size(); ++body) {
-    const std::string& to = a.to[body];
-    const std::string& out = outs[body];
-    try {
-      OutputBatch body_outputs;
-      clock.reset();
-      const BodyMesh body_b = read_body(to);
-      const double load_b_ms = clock.ms();
-      ResizeResult result = binding.resize(body_b, progress);
-      clock.reset();
-      progress.stage("writing " + out);
-      const ObjWriteReport written = write_garment_obj(out, *garment, result.positions);
-      if (!a.curves_out.empty()) write_curves_obj(a.curves_out, result.features);
-      nlohmann::json& r = result.report;
-      r["timings_ms"]["write"] = clock.ms();
-      r["timings_ms"]["load"] = load_ms + load_b_ms;
-      r["timings_ms"]["bind"] = binding.bind_report();
-      r["timings_ms"]["total"] = total.ms();
-      // On stderr too (not only in the report), naming the body or the output.
-      for (const auto& w : result.warnings) std::fprintf(stderr, "refit: warning: %s: %s\n", to.c_str(), w.c_str());
-      for (const auto& w : written.warnings) {
-        std::fprintf(stderr, "refit: warning: %s: %s\n", out.c_str(), w.c_str());
-        result.warnings.push_back(w);
-      }
-      if (written.normals_recomputed > 0)  // what the writer always does: the report says how many
-        result.warnings.push_back(std::to_string(written.normals_recomputed) + " vn normals recomputed from the new positions");
-      for (const auto& w : garment_warnings) result.warnings.push_back(w);
-      r["version"] = kVersion;
-      r["garment"] = garment_summary(*garment);
-      r["garment"]["file"] = a.garment;
-      r["body_a"] = a.from;
-      r["body_b"] = to;
-      r["output"] = out;
-      r["units"] = a.units;
-      r["peak_memory_mb"] = peak_memory_mb();
-      r["warnings"] = result.warnings;
-      reports.push_back(r);
-      body_outputs.commit();
-      progress.stage("done " + out);
-      total.reset();
-    } catch (const Error& e) {
-      if (!batch) throw;
-      ++failed;
-      std::fprintf(stderr, "refit: error: %s (body skipped)\n", e.what());
-      reports.push_back({{"body_b", to}, {"error", e.what()}});
-    }
-  }
-  if (!a.report.empty()) {
-    nlohmann::json doc = !batch ? reports[0] : nlohmann::json{{"version", kVersion}, {"bodies", reports}};
-    write_json_report(a.report, doc);
-  }
-  all_outputs.commit();
-  if (folder) folder->keep();
-  if (failed > 0) {
-    std::fprintf(stderr, "refit: %zu of %zu bodies failed\n", failed, a.to.size());
-    return 4;
-  }
-  return 0;
+  run.bind_report = binding.bind_report();
+  return run.bodies(
+      [&](const BodyMesh& body_b, const std::string& out) {
+        ResizeResult r = binding.resize(body_b, progress);
+        Stopwatch write;
+        progress.stage("writing " + out);
+        ObjWriteReport written = write_garment_obj(out, *garment, r.positions);
+        r.report["timings_ms"]["write"] = write.ms();
+        return BodyResult{std::move(r.report), std::move(r.warnings), std::move(written), std::move(r.features)};
+      },
+      folder);
 }
 
 // Switches that change the method or the solver: a help section of their own.

@@ -1,6 +1,7 @@
 #include <refit/chunked/chunk_plan.hpp>
 
 #include <refit/core/error.hpp>
+#include <refit/core/progress.hpp>
 
 #include <algorithm>
 #include <cctype>
@@ -50,11 +51,15 @@ std::size_t parse_size(const std::string& text, const std::string& what) {
   return static_cast<std::size_t>(value * scale);
 }
 
-double in_memory_estimate_mb(const GarmentSize& s) {
-  // Measured on the dense MakeHuman dress (1.07M vertices, 144 MB of text, full
-  // pipeline with features): 729 MB peak, about 545 bytes per vertex beside the
-  // text. Faces are counted through the vertices (about two per vertex).
-  return (40.0 * kMB + double(s.file_bytes) + 560.0 * double(s.vertices)) / kMB;
+double estimated_agents(std::size_t vertices, std::size_t agent_budget, double voxel) {
+  if (voxel == 0.0) return double(std::min(agent_budget, std::max<std::size_t>(vertices, 1000)));
+  return double(agent_budget);
+}
+
+bool might_exceed_memory(std::size_t file_bytes) {
+  // A `v` line takes at least 8 bytes ("v 0 0 0\n"); the in-memory run about
+  // 600 bytes per vertex (estimated_memory_mb).
+  return 600.0 * double(file_bytes) / 8.0 > physical_memory_mb() * kMB;
 }
 
 ChunkPlan plan_chunks(const GarmentSize& s, const ChunkOptions& o) {
@@ -63,8 +68,10 @@ ChunkPlan plan_chunks(const GarmentSize& s, const ChunkOptions& o) {
   const double n = double(std::max<std::size_t>(s.vertices, 1));
   const double faces_per_vertex = std::max(1.0, double(s.faces) / n);
   const double resident = kResidentVertexBytes * n;
-  if (o.memory_budget > 0) {
-    const double budget = double(o.memory_budget);
+  // Without a budget (and not forced), the machine's memory, less a quarter for the rest of it.
+  const double machine = o.chunk_vertices > 0 ? 0.0 : 0.75 * physical_memory_mb() * kMB;
+  if (o.memory_budget > 0 || machine > 0.0) {
+    const double budget = o.memory_budget > 0 ? double(o.memory_budget) : machine;
     double free = budget - kFixedBytes - resident;
     const double least = 4096.0 * (kChunkVertexBytes + faces_per_vertex * kChunkFaceBytes) + 3.0 * (1 << 18);
     if (free < least) {
@@ -74,7 +81,7 @@ ChunkPlan plan_chunks(const GarmentSize& s, const ChunkOptions& o) {
                     "vertex, the smallest chunks), more than the memory budget of %.0f MB",
                     s.vertices, (kFixedBytes + resident + least) / kMB, kFixedBytes / kMB, kResidentVertexBytes,
                     budget / kMB);
-      throw Error(text);
+      throw ResourceError(text);
     }
     // Positions stay in memory for the face passes when they take at most half
     // of what is left; else they are gathered from disk by windows.
@@ -108,9 +115,10 @@ ChunkPlan plan_chunks(const GarmentSize& s, const ChunkOptions& o) {
   return p;
 }
 
-bool use_chunks(const GarmentSize& s, const ChunkOptions& o) {
+bool use_chunks(const GarmentSize&, const ChunkOptions& o, double in_memory_mb) {
   if (o.chunk_vertices > 0) return true;
-  return o.memory_budget > 0 && in_memory_estimate_mb(s) > double(o.memory_budget) / kMB;
+  const double budget = o.memory_budget > 0 ? double(o.memory_budget) / kMB : physical_memory_mb();
+  return budget > 0.0 && in_memory_mb > budget;
 }
 
 }  // namespace refit

@@ -25,9 +25,14 @@ struct GarmentSize {
   std::size_t file_bytes = 0, vertices = 0, faces = 0;
 };
 
-/// The in-memory mode's estimated peak for a garment (MB): its text, its
-/// elements, and what the stages hold per vertex (measured: bench/README.md).
-double in_memory_estimate_mb(const GarmentSize& size);
+/// The surface step's agent count, estimated from the vertex count (the
+/// automatic voxel size's budget; with an explicit voxel size, the budget too:
+/// the binding refuses a voxel size that would make far more).
+double estimated_agents(std::size_t vertices, std::size_t agent_budget, double voxel);
+
+/// Whether a garment file of this size could need more memory than this
+/// machine has in memory (then its vertices are counted before choosing).
+bool might_exceed_memory(std::size_t file_bytes);
 
 struct ChunkPlan {
   std::size_t chunk_vertices = 0;  // vertices per chunk
@@ -43,7 +48,8 @@ struct ChunkPlan {
 ChunkPlan plan_chunks(const GarmentSize& size, const ChunkOptions& options);
 
 /// Whether `size` is resized in chunks: forced by options.chunk_vertices, or
-/// the in-memory estimate above the budget.
-bool use_chunks(const GarmentSize& size, const ChunkOptions& options);
+/// the in-memory run's estimate (`in_memory_mb`, estimated_memory_mb) above the
+/// budget, or above this machine's memory without one.
+bool use_chunks(const GarmentSize& size, const ChunkOptions& options, double in_memory_mb);
 
 }  // namespace refit

@@ -10,6 +10,7 @@
 #include <refit/chunked/chunked_surface.hpp>
 #include <refit/chunked/chunked_symmetry.hpp>
 #include <refit/core/error.hpp>
+#include <refit/pipeline/input_checks.hpp>
 #include <refit/pipeline/resize_report.hpp>
 #include <refit/pipeline/units.hpp>
 #include <refit/surface/feature_snap.hpp>
@@ -73,6 +74,13 @@ bool any_moved(const PointFile& a, const PointFile& b, std::size_t chunk) {
 
 }  // namespace
 
+void check_chunked_options(const ResizeOptions& options) {
+  if (options.metrics) throw Error("--metrics is not available in the chunked mode");
+  // Refused, never skipped: the output would differ from the in-memory mode's.
+  if (options.stage == Stage::Full && options.collision)
+    throw Error("the chunked mode does not do the collision step yet (use --no-collision)");
+}
+
 ChunkedBinding::~ChunkedBinding() = default;
 
 ChunkedBinding::ChunkedBinding(std::shared_ptr<const GarmentStore> garment, BodyMesh body_a, ResizeOptions options,
@@ -85,7 +93,8 @@ ChunkedBinding::ChunkedBinding(std::shared_ptr<const GarmentStore> garment, Body
   const GarmentStore& g = *store_;
   const double per_cm = units_per_cm(options_.units);
   if (g.vertex_count() == 0) throw Error("garment: empty garment (no vertices)");
-  if (options_.metrics) throw Error("--metrics is not available in the chunked mode");
+  check_chunked_options(options_);
+  check_garment_on_body_a(g.low(), g.high(), g.obj().file(), body_a_.mesh(), per_cm);
   Stopwatch clock;
   progress.stage("binding " + std::to_string(g.vertex_count()) + " garment vertices to " + body_a_.mesh().name +
                  " (in chunks of " + std::to_string(plan_.chunk_vertices) + ")");
@@ -151,8 +160,12 @@ ChunkedBinding::ChunkedBinding(std::shared_ptr<const GarmentStore> garment, Body
     const Points all = concat_rows(samples);
     if (all.rows() > 0) bound_->feature_attachment = chunked_attach(g, x, plan_, all);
     std::vector<std::uint32_t> layers;
-    SurfaceGarmentPart part = chunked_surface_part(g, x, plan_, all, so, bound_->feature_attachment, layers);
-    bound_->surface = SurfaceBinding::bind_agents(std::move(part), all, so, bound_->feature_attachment);
+    try {
+      SurfaceGarmentPart part = chunked_surface_part(g, x, plan_, all, so, bound_->feature_attachment, layers);
+      bound_->surface = SurfaceBinding::bind_agents(std::move(part), all, so, bound_->feature_attachment);
+    } catch (const Error& e) {  // e.g. a voxel size too small for the garment: name its file
+      throw input_error(g.obj().file(), e.what());
+    }
     if (!layers.empty()) {
       bound_->layers.emplace(plan_.folder);
       bound_->layers->write(0, std::span<const std::uint32_t>(layers));
@@ -182,7 +195,9 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
 
   // Step 1: primary resizing (section 3), bound and applied a chunk at a time.
   progress.stage("warping to " + body_b.name);
+  report["memory_estimate_mb"] = plan_.estimate_mb;
   const TriangleFrames frames_b = compute_frames(body_b);
+  check_body_b_scale(body_a_.mesh(), body_b, frames_b);
   PointFile warped(plan_.folder, nv);
   std::size_t capped = 0;
   for_each_chunk(g.positions(), chunk, [&](std::size_t first, const Points& original) {
@@ -204,7 +219,11 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
   const PointFile* final_positions = &warped;
   std::optional<PointFile> surfaced, symmetrised;
 
-  if (options_.stage != Stage::Warp) {
+  // Body B is body A wherever the garment is bound, so the warp kept every vertex
+  // to the bit: the garment as given is the answer (GarmentBinding::resize).
+  const bool unchanged = options_.stage != Stage::Warp && !any_moved(g.positions(), warped, chunk);
+  if (unchanged) report["unchanged"] = true;
+  if (options_.stage != Stage::Warp && !unchanged) {
     clock.reset();
     const BodySurface surface_b(body_b);
     const auto distance_b = [&](const Vec3& p) { return surface_b.closest(p).distance; };
@@ -368,7 +387,6 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
         final_positions = &*symmetrised;
       }
       feature_before_collision = carried(at, *final_positions);
-      if (options_.collision) throw Error("the chunked mode does not do the collision step yet (use --no-collision)");
     }
     if (bound_->surface && !curves.curves.empty())
       report_written_features(curves, carried(bound_->feature_attachment, *final_positions),
@@ -389,8 +407,8 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
     };
   g.obj().write(out, edits);
   if (normals) {
-    result.warnings.insert(result.warnings.end(), normals->warnings.begin(), normals->warnings.end());
-    if (normals->count > 0) result.warnings.push_back(std::to_string(normals->count) + " vn normals recomputed from the new positions");
+    result.written.warnings = normals->warnings;
+    result.written.normals_recomputed = normals->count;
   }
   timings["write"] = clock.ms();
   report["chunks"] = {{"vertices", plan_.chunk_vertices},

@@ -20,7 +20,12 @@ struct ChunkedResult {
   FeatureResult features;  // per feature curve: original, warped, optimised samples
   nlohmann::json report;   // as ResizeResult's
   std::vector<std::string> warnings;
+  ObjWriteReport written;  // what writing the garment said (write_garment_obj's report)
 };
+
+/// Throws refit::Error when `options` ask for what the chunked mode does not do
+/// (the collision step, --metrics): checked before any work.
+void check_chunked_options(const ResizeOptions& options);
 
 /// GarmentBinding for a garment in a GarmentStore.
 class ChunkedBinding {

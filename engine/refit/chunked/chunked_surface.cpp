@@ -39,11 +39,7 @@ double face_area(const ElementBlock& b, std::size_t f) {
 
 }  // namespace
 
-double chunked_surface_voxel(const GarmentStore& g, const PointGather& x, const ChunkPlan& plan,
-                             const SurfaceOptions& options) {
-  if (options.voxel != 0.0) return options.voxel;
-  const std::size_t budget = std::min(options.agent_budget, std::max<std::size_t>(g.vertex_count(), 1000));
-  if (budget == 0) throw Error("surface: the agent budget must be at least 1");
+std::pair<double, double> chunked_surface_measure(const GarmentStore& g, const PointGather& x, const ChunkPlan& plan) {
   // surface_measure's two deterministic sums.
   DeterministicSum area(0, g.face_count(), kGrain), length(0, g.line_count(), kGrain);
   for_each_block(g.faces(), plan.chunk_faces, x, [&](const ElementBlock& b) {
@@ -57,7 +53,13 @@ double chunked_surface_voxel(const GarmentStore& g, const PointGather& x, const 
       length.add(b.first + l, s);
     }
   });
-  return auto_voxel_size(area.result(), length.result(), Vec3(g.high() - g.low()), budget);
+  return {area.result(), length.result()};
+}
+
+double chunked_surface_voxel(const GarmentStore& g, std::pair<double, double> measure, const SurfaceOptions& options) {
+  if (options.voxel != 0.0) return options.voxel;
+  const std::size_t budget = std::min(options.agent_budget, std::max<std::size_t>(g.vertex_count(), 1000));
+  return auto_voxel_size(measure.first, measure.second, Vec3(g.high() - g.low()), budget);
 }
 
 std::vector<std::uint32_t> chunked_layers(const GarmentStore& g, const PointGather& x, const ChunkPlan& plan,
@@ -300,7 +302,9 @@ SurfaceGarmentPart chunked_surface_part(const GarmentStore& g, const PointGather
   Stopwatch clock;
   SurfaceGarmentPart part;
   part.voxel_auto = options.voxel == 0.0;
-  part.voxel = chunked_surface_voxel(g, x, plan, options);
+  const std::pair<double, double> measure = chunked_surface_measure(g, x, plan);
+  part.voxel = chunked_surface_voxel(g, measure, options);
+  check_agent_count(measure.first, measure.second, Vec3(g.high() - g.low()), part.voxel, options.max_agents);
   part.grid = make_voxel_grid(g.low(), g.high(), features, part.voxel);
   part.vertex_count = g.vertex_count();
   vertex_layer.clear();

@@ -8,13 +8,16 @@
 #include <refit/surface/surface.hpp>
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace refit {
 
-/// surface_voxel for a stored garment.
-double chunked_surface_voxel(const GarmentStore& g, const PointGather& x, const ChunkPlan& plan,
-                             const SurfaceOptions& options);
+/// surface_measure for a stored garment: the face area and the `l` lines' length.
+std::pair<double, double> chunked_surface_measure(const GarmentStore& g, const PointGather& x, const ChunkPlan& plan);
+
+/// surface_voxel for a stored garment of that measure.
+double chunked_surface_voxel(const GarmentStore& g, std::pair<double, double> measure, const SurfaceOptions& options);
 
 /// garment_layers for a stored garment (per vertex; in memory, 4 bytes per vertex).
 std::vector<std::uint32_t> chunked_layers(const GarmentStore& g, const PointGather& x, const ChunkPlan& plan,

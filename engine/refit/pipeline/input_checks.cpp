@@ -38,16 +38,20 @@ void check_human_size(const BodyMesh& body_a, double units_per_cm) {
 }
 
 void check_garment_on_body_a(const Garment& garment, const BodyMesh& body_a, double units_per_cm) {
+  check_garment_on_body_a(garment.positions.colwise().minCoeff().transpose(), garment.positions.colwise().maxCoeff().transpose(),
+                          file_of(garment), body_a, units_per_cm);
+}
+
+void check_garment_on_body_a(const Vec3& glo, const Vec3& ghi, const std::string& garment_file, const BodyMesh& body_a,
+                             double units_per_cm) {
   const Vec3 lo = body_a.vertices.colwise().minCoeff().transpose(), hi = body_a.vertices.colwise().maxCoeff().transpose();
   const double height = (hi - lo).maxCoeff();
   const std::string units = units_name(units_per_cm);
-  const Vec3 glo = garment.positions.colwise().minCoeff().transpose(),
-             ghi = garment.positions.colwise().maxCoeff().transpose();
   const Vec3 centre = 0.5 * (glo + ghi);
   const double margin = 0.2 * height, across = (ghi - glo).maxCoeff();
   const bool centred = (centre.array() >= lo.array() - margin).all() && (centre.array() <= hi.array() + margin).all();
   if (!centred || across > 2 * height)
-    throw input_error(file_of(garment), "the garment (" + number(across) + " " + units + " across, centred at " +
+    throw input_error(garment_file, "the garment (" + number(across) + " " + units + " across, centred at " +
                                            number(centre.x()) + " " + number(centre.y()) + " " + number(centre.z()) +
                                            ") does not sit on body A (" + file_of(body_a) + ", " + number(height) + " " +
                                            units + " tall): are they in the same units and place?");

@@ -6,6 +6,8 @@
 #include <refit/body/body_mesh.hpp>
 #include <refit/core/garment.hpp>
 
+#include <string>
+
 namespace refit {
 
 /// Body A is of human size in the garment's units: 30 to 300 cm along its
@@ -17,6 +19,9 @@ void check_human_size(const BodyMesh& body_a, double units_per_cm);
 /// fifth of A's height, and at most twice as long. Throws refit::Error naming
 /// the garment's file (`units_per_cm` only names the units in the message).
 void check_garment_on_body_a(const Garment& garment, const BodyMesh& body_a, double units_per_cm);
+/// The same for a garment whose positions' box is [lo, hi] (a garment not in memory).
+void check_garment_on_body_a(const Vec3& lo, const Vec3& hi, const std::string& garment_file, const BodyMesh& body_a,
+                             double units_per_cm);
 
 /// Body B is from half to twice body A's height and not collapsed (at most half
 /// of its triangles, `frames_b`, of zero area). Throws refit::Error naming body B's file.
