@@ -1,0 +1,258 @@
+#include <refit/attach/element_tree.hpp>
+
+#include <refit/body/body_surface.hpp>
+#include <refit/core/parallel.hpp>
+#include <refit/core/spatial_order.hpp>
+
+#include <xmmintrin.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+
+namespace refit::detail {
+
+namespace {
+
+constexpr std::size_t kLeaf = 4;
+constexpr float kFloatInf = std::numeric_limits<float>::infinity();
+
+// v rounded to a float no larger (below) or no smaller (above) than v.
+float float_below(double v) {
+  const float f = static_cast<float>(v);
+  return double(f) > v ? std::nextafter(f, -kFloatInf) : f;
+}
+float float_above(double v) {
+  const float f = static_cast<float>(v);
+  return double(f) < v ? std::nextafter(f, kFloatInf) : f;
+}
+
+// The closest point of p on element e, and its barycentric weights on e's
+// corners (computed for the winner only: the same arithmetic either way).
+Vec3 closest_point(const Vec3& p, const Points& x, const Element& e) {
+  const Vec3 a = row3(x, e.v[0]);
+  if (e.corners == 1) return a;
+  if (e.corners == 2) {
+    const Vec3 d = row3(x, e.v[1]) - a;
+    const double len2 = d.squaredNorm();
+    const double t = len2 > 0.0 ? std::clamp((p - a).dot(d) / len2, 0.0, 1.0) : 0.0;
+    return a + t * d;
+  }
+  return closest_point_on_triangle(p, a, row3(x, e.v[1]), row3(x, e.v[2]));
+}
+
+ElementPoint with_weights(const Vec3& p, const Points& x, const Element& e, const Vec3& q) {
+  ElementPoint c;
+  const Vec3 a = row3(x, e.v[0]);
+  if (e.corners == 1) {
+    c = {0.0, {e.v[0], e.v[0], e.v[0]}, {1.0, 0.0, 0.0}, a};
+  } else if (e.corners == 2) {
+    const Vec3 d = row3(x, e.v[1]) - a;
+    const double len2 = d.squaredNorm();
+    const double t = len2 > 0.0 ? std::clamp((p - a).dot(d) / len2, 0.0, 1.0) : 0.0;
+    c = {0.0, {e.v[0], e.v[1], e.v[1]}, {1.0 - t, t, 0.0}, q};
+  } else {
+    const Vec3 b = row3(x, e.v[1]), cc = row3(x, e.v[2]);
+    const Vec3 v0 = b - a, v1 = cc - a, v2 = q - a;
+    const double d00 = v0.dot(v0), d01 = v0.dot(v1), d11 = v1.dot(v1), d20 = v2.dot(v0), d21 = v2.dot(v1);
+    const double den = d00 * d11 - d01 * d01;
+    const double wv = den != 0.0 ? (d11 * d20 - d01 * d21) / den : 0.0;
+    const double ww = den != 0.0 ? (d00 * d21 - d01 * d20) / den : 0.0;
+    c = {0.0, e.v, {1.0 - wv - ww, wv, ww}, q};
+  }
+  c.d2 = (c.point - p).squaredNorm();
+  return c;
+}
+
+}  // namespace
+
+ElementPoint closest_on_element(const Vec3& p, const Points& x, const Element& e) {
+  return with_weights(p, x, e, closest_point(p, x, e));
+}
+
+void ElementTree::Box::grow(const Box& o) {
+  for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], o.lo[k]), hi[k] = std::max(hi[k], o.hi[k]);
+}
+
+ElementTree::Box ElementTree::box_of(const Element& e) const {
+  Vec3 lo = row3(x_, e.v[0]), hi = lo;
+  for (int k = 1; k < 3; ++k) lo = lo.cwiseMin(row3(x_, e.v[k])), hi = hi.cwiseMax(row3(x_, e.v[k]));
+  Box b;
+  for (int k = 0; k < 3; ++k) b.lo[k] = float_below(lo[k]), b.hi[k] = float_above(hi[k]);
+  return b;
+}
+
+ElementTree::Disc ElementTree::disc_of(const Element& e) const {
+  const Vec3 a = row3(x_, e.v[0]), b = row3(x_, e.v[1]), c = row3(x_, e.v[2]);
+  const Vec3 g = e.corners == 3 ? Vec3((a + b + c) / 3.0) : Vec3(0.5 * (a + b));
+  Vec3 n = Vec3::Zero();
+  if (e.corners == 3) {
+    const Vec3 normal = (b - a).cross(c - a);
+    const double len = normal.norm();
+    if (len > 0.0 && std::isfinite(len)) n = normal / len;  // else a ball about g
+  }
+  Disc d;
+  for (int k = 0; k < 3; ++k) d.n[k] = float(n[k]), d.g[k] = float(g[k]);
+  d.r = float_above(std::max({(a - g).norm(), (b - g).norm(), (c - g).norm()}));
+  return d;
+}
+
+// A point of the triangle lies in its plane and within r of g there, so its
+// distance from q is at least sqrt(h^2 + (t - r)^2) (h: q's height over the
+// plane, t: its distance from g along the plane; with n = 0, a ball: h = 0 and
+// t = |q - g|). The margin taken off covers
+// the float rounding of n, g and of the arithmetic (t loses precision right
+// over g, where it does not matter), for points as far as `scale` (the largest
+// coordinate of q) from the origin.
+float ElementTree::distance2(const Disc& d, const std::array<float, 3>& q, float scale) {
+  const float v0 = q[0] - d.g[0], v1 = q[1] - d.g[1], v2 = q[2] - d.g[2];
+  const float h = v0 * d.n[0] + v1 * d.n[1] + v2 * d.n[2];
+  const float t = std::sqrt(std::max(v0 * v0 + v1 * v1 + v2 * v2 - h * h, 0.0f));
+  const float in_plane = std::max(t - d.r, 0.0f);
+  const float g = std::max({std::abs(d.g[0]), std::abs(d.g[1]), std::abs(d.g[2])});
+  const float bound = std::sqrt(h * h + in_plane * in_plane) - 4e-6f * (scale + g + d.r);
+  return bound > 0.0f ? bound * bound : 0.0f;
+}
+
+ElementTree::ElementTree(const std::vector<Element>& elements, const Points& x) : x_(x) {
+  const std::size_t n = elements.size();
+  if (n == 0) return;
+  const CurveOrder curve = curve_order(n, [&](std::size_t i) {
+    const Element& e = elements[i];
+    Vec3 lo = row3(x_, e.v[0]), hi = lo;
+    for (int k = 1; k < 3; ++k) lo = lo.cwiseMin(row3(x_, e.v[k])), hi = hi.cwiseMax(row3(x_, e.v[k]));
+    return Vec3(0.5 * (lo + hi));
+  });
+  elements_.resize(n);
+  id_.resize(n);
+  disc_.resize(n);
+  parallel_for(0, n, 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) {
+      const Index i = curve.order[k];
+      elements_[k] = elements[i];
+      id_[k] = i;
+      disc_[k] = disc_of(elements[i]);
+    }
+  });
+  nodes_.reserve(n / kLeaf / 2 + 1);
+  root_ = build(curve.key, 0, n, root_box_);
+}
+
+ElementTree::Ref ElementTree::build(const std::vector<std::uint64_t>& key, std::size_t b, std::size_t e, Box& box) {
+  if (e - b <= kLeaf) {
+    box = box_of(elements_[b]);
+    for (std::size_t k = b + 1; k < e; ++k) box.grow(box_of(elements_[k]));
+    return {std::uint32_t(b), std::uint8_t(e - b)};
+  }
+  // Split where the highest bit in which the range's keys differ turns to 1
+  // (keys all equal: in the middle), then each half again: up to four children.
+  const auto split = [&](std::size_t lo, std::size_t hi) {
+    if (key[lo] == key[hi - 1]) return lo + (hi - lo) / 2;
+    const std::uint64_t bit = std::uint64_t(1) << (63 - std::countl_zero(key[lo] ^ key[hi - 1]));
+    return std::size_t(std::partition_point(key.begin() + std::ptrdiff_t(lo), key.begin() + std::ptrdiff_t(hi),
+                                            [bit](std::uint64_t k) { return !(k & bit); }) -
+                       key.begin());
+  };
+  std::array<std::pair<std::size_t, std::size_t>, 4> part;
+  std::size_t parts = 0;
+  const std::size_t mid = split(b, e);
+  for (const auto& [lo, hi] : {std::pair{b, mid}, std::pair{mid, e}}) {
+    if (hi - lo <= kLeaf) {
+      part[parts++] = {lo, hi};
+    } else {
+      const std::size_t m = split(lo, hi);
+      part[parts++] = {lo, m};
+      part[parts++] = {m, hi};
+    }
+  }
+  const auto index = static_cast<std::uint32_t>(nodes_.size());
+  nodes_.emplace_back();
+  Node node;
+  for (int s = 0; s < 4; ++s) {
+    for (int k = 0; k < 3; ++k) node.lo[k][s] = kFloatInf, node.hi[k][s] = -kFloatInf;
+    node.child[s] = 0;
+    node.count[s] = 0xff;
+  }
+  for (std::size_t s = 0; s < parts; ++s) {
+    Box child_box;
+    const Ref r = build(key, part[s].first, part[s].second, child_box);
+    for (int k = 0; k < 3; ++k) node.lo[k][s] = child_box.lo[k], node.hi[k][s] = child_box.hi[k];
+    node.child[s] = r.index;
+    node.count[s] = r.count;
+    if (s == 0) box = child_box;
+    else box.grow(child_box);
+  }
+  nodes_[index] = node;
+  return {index, 0};
+}
+
+ElementPoint ElementTree::closest(const Vec3& p, std::size_t& hint) const {
+  ElementPoint best;
+  if (elements_.empty() || !p.allFinite()) return best;
+  Index best_id = std::numeric_limits<Index>::max();
+  // Culling, in float against p rounded to float: a box or disc farther than
+  // the best so far plus what the rounding of p and of float arithmetic can
+  // hide. No element as close as the best is ever left out.
+  const double slack = 2e-7 * p.cwiseAbs().maxCoeff();
+  float limit2 = kFloatInf;
+  const auto take = [&](std::size_t k) {
+    const Vec3 q = closest_point(p, x_, elements_[k]);
+    const double d2 = (q - p).squaredNorm();
+    if (!(d2 < best.d2 || (d2 == best.d2 && id_[k] < best_id))) return;
+    best = with_weights(p, x_, elements_[k], q);
+    best_id = id_[k];
+    hint = k;
+    const double reach = std::sqrt(best.d2) * (1.0 + 1e-9) + slack;
+    limit2 = float_above(reach * reach * (1.0 + 1e-6));
+  };
+  if (hint < elements_.size()) take(hint);
+
+  const std::array<float, 3> pf = {float(p[0]), float(p[1]), float(p[2])};
+  const float scale = std::max({std::abs(pf[0]), std::abs(pf[1]), std::abs(pf[2])});
+  struct Entry {
+    Ref ref;
+    float d2;
+  };
+  std::array<Entry, 256> stack;
+  std::size_t top = 0;
+  float root_d2 = 0.0f;
+  for (int k = 0; k < 3; ++k) {
+    const float d = std::max(std::max(root_box_.lo[k] - pf[k], pf[k] - root_box_.hi[k]), 0.0f);
+    root_d2 += d * d;
+  }
+  stack[top++] = {root_, root_d2};
+  while (top > 0) {
+    const Entry e = stack[--top];
+    if (e.d2 > limit2) continue;
+    if (e.ref.count > 0) {
+      for (std::size_t k = e.ref.index; k < std::size_t(e.ref.index) + e.ref.count; ++k)
+        if (!(distance2(disc_[k], pf, scale) > limit2)) take(k);
+      continue;
+    }
+    const Node& node = nodes_[e.ref.index];
+    // The four children's box distances at once (SSE: x86-64's baseline).
+    __m128 acc = _mm_setzero_ps();
+    for (int k = 0; k < 3; ++k) {
+      const __m128 q = _mm_set1_ps(pf[k]);
+      const __m128 d = _mm_max_ps(_mm_max_ps(_mm_sub_ps(_mm_load_ps(node.lo[k].data()), q),
+                                             _mm_sub_ps(q, _mm_load_ps(node.hi[k].data()))),
+                                  _mm_setzero_ps());
+      acc = _mm_add_ps(acc, _mm_mul_ps(d, d));
+    }
+    alignas(16) std::array<float, 4> d2;
+    _mm_store_ps(d2.data(), acc);
+    // The children within reach in order of distance, the nearest pushed last (searched first).
+    std::array<int, 4> slot;
+    int m = 0;
+    for (int s = 0; s < 4; ++s) {
+      if (!(d2[s] <= limit2) || node.count[s] == 0xff) continue;
+      int j = m++;
+      for (; j > 0 && d2[slot[j - 1]] < d2[s]; --j) slot[j] = slot[j - 1];
+      slot[j] = s;
+    }
+    for (int j = 0; j < m; ++j) stack[top++] = {{node.child[slot[j]], node.count[slot[j]]}, d2[slot[j]]};
+  }
+  return best;
+}
+
+}  // namespace refit::detail

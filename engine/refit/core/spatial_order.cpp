@@ -1,0 +1,69 @@
+#include <refit/core/parallel.hpp>
+#include <refit/core/spatial_order.hpp>
+
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace refit {
+
+namespace {
+
+std::uint64_t spread3(std::uint64_t x) {
+  x &= 0x1fffff;
+  x = (x | x << 32) & 0x1f00000000ffffULL;
+  x = (x | x << 16) & 0x1f0000ff0000ffULL;
+  x = (x | x << 8) & 0x100f00f00f00f00fULL;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+  x = (x | x << 2) & 0x1249249249249249ULL;
+  return x;
+}
+
+}  // namespace
+
+CurveOrder curve_order(const Points& p) {
+  return curve_order(static_cast<std::size_t>(p.rows()), [&p](std::size_t i) { return row3(p, Index(i)); });
+}
+
+CurveOrder curve_order(std::size_t n, const std::function<Vec3(std::size_t)>& point) {
+  CurveOrder out;
+  out.order.resize(n);
+  out.key.resize(n);
+  if (n == 0) return out;
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 v = point(i);
+    for (int k = 0; k < 3; ++k)
+      if (std::isfinite(v[k])) lo[k] = std::min(lo[k], v[k]), hi[k] = std::max(hi[k], v[k]);
+  }
+  constexpr double kCells = double((1u << 21) - 1);
+  Vec3 scale;
+  for (int k = 0; k < 3; ++k) scale[k] = hi[k] > lo[k] ? kCells / (hi[k] - lo[k]) : 0.0;
+  // Key: 63 Morton bits, then the row (so keys are unique and the order total).
+  std::vector<std::pair<std::uint64_t, Index>> keys(n);
+  parallel_for(0, n, 1 << 14, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      const Vec3 v = point(i);
+      std::uint64_t key = ~std::uint64_t{0};
+      if (v.allFinite()) {
+        key = 0;
+        for (int k = 0; k < 3; ++k) {
+          const double c = std::clamp((v[k] - lo[k]) * scale[k], 0.0, kCells);
+          key |= spread3(static_cast<std::uint64_t>(c)) << k;
+        }
+      }
+      keys[i] = {key, Index(i)};
+    }
+  });
+  tbb::parallel_sort(keys.begin(), keys.end());
+  parallel_for(0, n, 1 << 14, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) out.order[i] = keys[i].second, out.key[i] = keys[i].first;
+  });
+  return out;
+}
+
+std::vector<Index> spatial_order(const Points& p) { return curve_order(p).order; }
+
+}  // namespace refit
