@@ -93,24 +93,32 @@ ElementTree::Disc ElementTree::disc_of(const Element& e) const {
   }
   Disc d;
   for (int k = 0; k < 3; ++k) d.n[k] = float(n[k]), d.g[k] = float(g[k]);
-  d.r = float_above(std::max({(a - g).norm(), (b - g).norm(), (c - g).norm()}));
+  // The slab's half thickness and the radius, measured from the float n and g
+  // that the bound uses: a nearly collinear triangle's normal is rounding noise,
+  // not perpendicular to it, and then the slab is as thick as the triangle.
+  const Vec3 nf(d.n[0], d.n[1], d.n[2]), gf(d.g[0], d.g[1], d.g[2]);
+  double thick = 0.0, r = 0.0;
+  for (const Vec3& v : {a, b, c}) thick = std::max(thick, std::abs(nf.dot(v - gf))), r = std::max(r, (v - gf).norm());
+  d.thick = float_above(thick);
+  d.r = float_above(r);
   return d;
 }
 
-// A point of the triangle lies in its plane and within r of g there, so its
-// distance from q is at least sqrt(h^2 + (t - r)^2) (h: q's height over the
-// plane, t: its distance from g along the plane; with n = 0, a ball: h = 0 and
-// t = |q - g|). The margin taken off covers
-// the float rounding of n, g and of the arithmetic (t loses precision right
-// over g, where it does not matter), for points as far as `scale` (the largest
-// coordinate of q) from the origin.
+// A point of the element lies within `thick` of the plane (n, g) and within r
+// of g along it, so its distance from q is at least sqrt((|h| - thick)^2 + (t - r)^2)
+// (h: q's height over the plane, t: its distance from g along the plane, each
+// term at least 0; with n = 0, a ball: h = 0 and t = |q - g|). The margin taken
+// off covers the float rounding of n's length and of the arithmetic (t loses
+// precision right over g, where it does not matter), for points as far as
+// `scale` (the largest coordinate of q) from the origin.
 float ElementTree::distance2(const Disc& d, const std::array<float, 3>& q, float scale) {
   const float v0 = q[0] - d.g[0], v1 = q[1] - d.g[1], v2 = q[2] - d.g[2];
   const float h = v0 * d.n[0] + v1 * d.n[1] + v2 * d.n[2];
   const float t = std::sqrt(std::max(v0 * v0 + v1 * v1 + v2 * v2 - h * h, 0.0f));
+  const float off_plane = std::max(std::abs(h) - d.thick, 0.0f);
   const float in_plane = std::max(t - d.r, 0.0f);
   const float g = std::max({std::abs(d.g[0]), std::abs(d.g[1]), std::abs(d.g[2])});
-  const float bound = std::sqrt(h * h + in_plane * in_plane) - 4e-6f * (scale + g + d.r);
+  const float bound = std::sqrt(off_plane * off_plane + in_plane * in_plane) - 4e-6f * (scale + g + d.r);
   return bound > 0.0f ? bound * bound : 0.0f;
 }
 

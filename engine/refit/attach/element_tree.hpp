@@ -32,8 +32,9 @@ ElementPoint closest_on_element(const Vec3& p, const Points& x, const Element& e
 /// first differ (a spatial split, as in Karras' linear BVH), in nodes of four
 /// children whose boxes are kept in the parent (one node read tests four
 /// boxes) and leaves of a few elements, each with a bound of its own: for a
-/// triangle the disc in its plane that holds it (tight for points well off a
-/// finely meshed surface, where boxes of tilted triangles are not), else a ball.
+/// triangle the disc in its plane that holds it, as thick as the rounding of
+/// its normal needs (tight for points well off a finely meshed surface, where
+/// boxes of tilted triangles are not), else a ball.
 /// A query descends nearer children first, so its best distance drops at once
 /// and every box or disc farther than that is skipped. Keeps a reference to `x`.
 class ElementTree {
@@ -53,9 +54,9 @@ class ElementTree {
     std::array<float, 3> lo, hi;
     void grow(const Box& o);
   };
-  struct Disc {  // plane normal n (zero: a ball) through centre g, r: radius about g holding the element
-    std::array<float, 3> n, g;
-    float r;
+  struct Disc {  // plane normal n (zero: a ball) through centre g; the element within
+    std::array<float, 3> n, g;  // `thick` of the plane and within r of g
+    float r, thick;
   };
   struct alignas(16) Node {  // four children: boxes by axis and slot, and what they are
     std::array<std::array<float, 4>, 3> lo, hi;
