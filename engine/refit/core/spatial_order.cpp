@@ -9,20 +9,6 @@
 
 namespace refit {
 
-namespace {
-
-std::uint64_t spread3(std::uint64_t x) {
-  x &= 0x1fffff;
-  x = (x | x << 32) & 0x1f00000000ffffULL;
-  x = (x | x << 16) & 0x1f0000ff0000ffULL;
-  x = (x | x << 8) & 0x100f00f00f00f00fULL;
-  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
-  x = (x | x << 2) & 0x1249249249249249ULL;
-  return x;
-}
-
-}  // namespace
-
 CurveOrder curve_order(const Points& p) {
   return curve_order(static_cast<std::size_t>(p.rows()), [&p](std::size_t i) { return row3(p, Index(i)); });
 }

@@ -21,6 +21,17 @@ CurveOrder curve_order(const Points& points);
 /// The same for n points given by point(i) (no matrix of them is made).
 CurveOrder curve_order(std::size_t n, const std::function<Vec3(std::size_t)>& point);
 
+/// The low 21 bits of x spread to every third bit (one axis of a Morton key).
+inline std::uint64_t spread3(std::uint64_t x) {
+  x &= 0x1fffff;
+  x = (x | x << 32) & 0x1f00000000ffffULL;
+  x = (x | x << 16) & 0x1f0000ff0000ffULL;
+  x = (x | x << 8) & 0x100f00f00f00f00fULL;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+  x = (x | x << 2) & 0x1249249249249249ULL;
+  return x;
+}
+
 /// curve_order(points).order.
 std::vector<Index> spatial_order(const Points& points);
 

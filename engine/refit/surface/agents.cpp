@@ -1,6 +1,7 @@
 #include <refit/body/centre_tree.hpp>
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
+#include <refit/core/spatial_order.hpp>
 #include <refit/core/weld.hpp>
 #include <refit/surface/agents.hpp>
 #include <refit/surface/samples.hpp>
@@ -21,16 +22,6 @@ namespace {
 using namespace sampling;
 constexpr std::size_t kGrain = 2048;
 constexpr std::uint32_t kMaxCell = (1u << 21) - 1;
-
-std::uint64_t spread3(std::uint64_t x) {
-  x &= 0x1fffff;
-  x = (x | x << 32) & 0x1f00000000ffffULL;
-  x = (x | x << 16) & 0x1f0000ff0000ffULL;
-  x = (x | x << 8) & 0x100f00f00f00f00fULL;
-  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
-  x = (x | x << 2) & 0x1249249249249249ULL;
-  return x;
-}
 
 void check_garment(const Garment& g) {
   const std::size_t n = g.vertex_count();
