@@ -11,7 +11,8 @@ cd "$(dirname "$0")/.."
 packages=(cmake ninja-build g++ pkg-config libtbb-dev libeigen3-dev libembree-dev
           libgtest-dev libgmock-dev libbenchmark-dev libnanoflann-dev nlohmann-json3-dev libstb-dev
           libcli11-dev python3-numpy python3-scipy clang libclang-rt-14-dev
-          pybind11-dev python3-dev python3-pytest libcsv-dev python3-distributed blender)
+          pybind11-dev python3-dev python3-pytest libcsv-dev python3-distributed blender
+          python3-ezdxf librsvg2-bin)
 sudo=""
 [ "$(id -u)" -eq 0 ] || sudo="sudo"
 missing=()

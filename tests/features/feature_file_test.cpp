@@ -138,3 +138,25 @@ TEST(FeatureFile, FileLevelErrors) {
   test::write_text(dir.file("ok.json"), kValid);
   EXPECT_EQ(read_feature_file(dir.file("ok.json")).size(), 3u);
 }
+
+namespace {
+
+// Seam curves (issue 16): a role of their own, checked like the rest.
+TEST(FeatureFile, RolesShapeAndSeam) {
+  const auto specs = parse_feature_json(one(R"({"name": "side", "role": "seam",
+      "plane": {"point": [0, 0, 0], "normal": [1, 0, 0]},
+      "curve": {"kind": "slice", "near": [0, 1, 0]}, "samples": 20})"), "f.json");
+  ASSERT_EQ(specs.size(), 1u);
+  EXPECT_EQ(specs[0].role, CurveRole::seam);
+  EXPECT_EQ(parse_feature_json(kValid, "f.json")[0].role, CurveRole::shape);
+  EXPECT_EQ(features_with_role(specs, CurveRole::shape).size(), 0u);
+  EXPECT_EQ(features_with_role(specs, CurveRole::seam).size(), 1u);
+  EXPECT_EQ(error_of(one(R"({"name": "x", "role": "dart", "curve": {"kind": "boundary", "near": [0, 0, 0]},
+      "samples": 20})")),
+            "f.json: feature 'x': 'role' must be \"shape\" or \"seam\", got \"dart\"");
+  EXPECT_EQ(error_of(one(R"({"name": "hem", "role": "seam", "curve": {"kind": "boundary", "near": [0, 0, 0]},
+      "samples": 20})")),
+            "f.json: feature 'hem': a seam cannot be a boundary curve (the garment is already cut along its boundary)");
+}
+
+}  // namespace

@@ -29,7 +29,7 @@ TEST(InspectCli, PrintsNameValueLines) {
   EXPECT_EQ(r.out,
             "vertices: 7\nfaces: 2\nlines: 1\npoints: 1\nunreferenced_vertices: 1\nedges: 5\n"
             "boundary_edges: 4\nnon_manifold_edges: 0\nboundary_loops: 1\ncomponents: 2\nlayers: 1\n"
-            "loose_vertices: 2\n");
+            "loose_vertices: 2\npanels: 1\npanel piece-1: 2 faces, 4 vertices, 1 boundary loops\n");
 }
 
 TEST(InspectCli, JsonHasTheSameNumbers) {

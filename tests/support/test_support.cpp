@@ -42,10 +42,10 @@ void write_text(const std::string& path, const std::string& text) {
   out << text;
 }
 
-CommandResult run_cli(const std::string& args) {
+CommandResult run_shell(const std::string& command) {
   TempDir dir;
   const std::string out = dir.file("stdout"), err = dir.file("stderr");
-  const std::string cmd = std::string("'") + REFIT_CLI_PATH + "' " + args + " >'" + out + "' 2>'" + err + "' </dev/null";
+  const std::string cmd = command + " >'" + out + "' 2>'" + err + "' </dev/null";
   const int status = std::system(cmd.c_str());
   CommandResult r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -53,5 +53,7 @@ CommandResult run_cli(const std::string& args) {
   r.err = read_text(err);
   return r;
 }
+
+CommandResult run_cli(const std::string& args) { return run_shell(std::string("'") + REFIT_CLI_PATH + "' " + args); }
 
 }  // namespace refit::test

@@ -28,6 +28,8 @@ struct CommandResult {
 };
 /// Runs `refit <args>` (the built CLI) through the shell.
 CommandResult run_cli(const std::string& args);
+/// Runs a shell command, capturing its output.
+CommandResult run_shell(const std::string& command);
 
 std::string read_text(const std::string& path);
 void write_text(const std::string& path, const std::string& text);

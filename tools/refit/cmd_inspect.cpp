@@ -5,7 +5,10 @@
 #include "command.hpp"
 
 #include <refit/core/topology.hpp>
+#include <refit/features/feature_file.hpp>
 #include <refit/io/obj_garment.hpp>
+#include <refit/patterns/pattern.hpp>
+#include <refit/patterns/report.hpp>
 #include <refit/surface/surface.hpp>
 
 #include <nlohmann/json.hpp>
@@ -20,7 +23,7 @@
 namespace {
 
 struct InspectOptions {
-  std::string file;
+  std::string file, features, units = "cm";
   bool json = false;
 };
 
@@ -29,8 +32,14 @@ const refit::cli::Register reg(
       auto opt = std::make_shared<InspectOptions>();
       app.add_option("file", opt->file, "Garment OBJ file")->required();
       app.add_flag("--json", opt->json, "Print one JSON object instead of 'name: value' lines");
+      app.add_option("--features", opt->features, "Feature file whose seam curves also cut the panels");
+      app.add_option("--units", opt->units, "Garment units (for the feature file)")->capture_default_str();
       return [opt]() -> int {
+        const std::vector<refit::FeatureSpec> specs =
+            opt->features.empty() ? std::vector<refit::FeatureSpec>{} : refit::read_feature_file(opt->features, opt->units);
         const refit::Garment g = refit::read_garment_obj(opt->file);
+        // Pattern pieces as `refit flatten` cuts them (docs/patterns.md).
+        const refit::PatternCut cut = refit::cut_pattern(g, specs, opt->file, opt->features);
         const refit::TopologyStats s = refit::topology_stats(g);
         // Layers as `refit resize` sees them (default agent budget): pieces with
         // their own agents; vertices on none (points, lines, small pieces) are loose.
@@ -52,14 +61,24 @@ const refit::cli::Register reg(
             {"components", s.components},
             {"layers", layers},
             {"loose_vertices", loose},
+            {"panels", cut.panels.panels.size()},
         };
         if (opt->json) {
           nlohmann::ordered_json j;
           j["file"] = opt->file;
           for (const auto& [name, value] : rows) j[name] = value;
+          nlohmann::ordered_json panels = nlohmann::ordered_json::array();
+          for (const refit::Panel& p : cut.panels.panels) {
+            nlohmann::ordered_json jp = {{"name", p.name}, {"faces", p.faces.size()}, {"vertices", p.vertices.size()},
+                                         {"boundary_loops", p.loops.size()}};
+            if (!p.problem.empty()) jp["problem"] = p.problem;
+            panels.push_back(jp);
+          }
+          j["panel_list"] = panels;
           std::printf("%s\n", j.dump(2).c_str());
         } else {
           for (const auto& [name, value] : rows) std::printf("%s: %zu\n", name, value);
+          for (const std::string& line : refit::panel_lines(cut)) std::printf("panel %s\n", line.c_str());
         }
         if (g.source)
           for (const std::string& w : g.source->warnings) std::fprintf(stderr, "refit: warning: %s\n", w.c_str());

@@ -2,6 +2,7 @@
 // resizes to each body; every output file is written atomically.
 #include "command.hpp"
 #include "manifest.hpp"
+#include "patterns_output.hpp"
 #include "report_file.hpp"
 
 #include <refit/chunked/chunked_resize.hpp>
@@ -34,6 +35,7 @@ struct ResizeArgs {
        paper_surface = false, plain_sweeps = false, v_cycles = false;
   SurfaceOptions surface;
   double clearance = 0.2;
+  PatternsOptions patterns;  // --patterns-out: the 2D patterns of each result (docs/patterns.md)
 };
 
 // A finite clearance from 0 to 10 cm: nan, inf or 1e6 would push the garment away (issue 17).
@@ -64,6 +66,9 @@ std::vector<std::string> output_paths(const ResizeArgs& a) {
   }
   if (!a.curves_out.empty()) outs.push_back(a.curves_out);
   if (!a.report.empty()) outs.push_back(a.report);
+  for (const std::string& to : a.patterns.dir.empty() ? std::vector<std::string>{} : a.to)
+    for (const std::string& p : pattern_paths(a.patterns.dir, std::filesystem::path(to).stem().string(), true))
+      outs.push_back(p);
   return outs;
 }
 
@@ -233,8 +238,9 @@ int run(ResizeArgs a) {
   }
   // Every output is checked before the work; a folder made for the run goes
   // again if the run fails.
-  std::optional<OutputFolder> folder;
+  std::optional<OutputFolder> folder, patterns_folder;
   if (!a.out_dir.empty()) folder.emplace(a.out_dir);
+  if (!a.patterns.dir.empty()) patterns_folder.emplace(a.patterns.dir);
   const std::vector<std::string> outs = output_paths(a);
   std::vector<std::string> ins = {a.garment, a.from};
   ins.insert(ins.end(), a.to.begin(), a.to.end());
@@ -272,6 +278,7 @@ int run(ResizeArgs a) {
                           body_a.triangles.size());
   if (obj && use_chunks(size, chunking, in_memory_mb)) {
     check_chunked_options(options);
+    if (!a.patterns.dir.empty()) throw Error("--patterns-out works in memory only, not in chunks (give no --memory-budget or --chunk-vertices, or run refit flatten on the result)");
     const ChunkPlan plan = plan_chunks(size, chunking);
     progress.stage("reading " + a.garment + " into " + plan.folder.string() + " in chunks of " +
                    std::to_string(plan.chunk_vertices) + " vertices (about " + std::to_string(int(plan.estimate_mb)) +
@@ -283,7 +290,7 @@ int run(ResizeArgs a) {
     run.garment_warnings = store->warnings();
     for (const auto& w : run.garment_warnings) std::fprintf(stderr, "refit: warning: %s\n", w.c_str());
     std::vector<FeatureSpec> features;
-    if (!a.features.empty()) features = read_feature_file(a.features, a.units);
+    if (!a.features.empty()) features = features_with_role(read_feature_file(a.features, a.units), CurveRole::shape);  // seams only cut patterns
     const ChunkedBinding binding(store, std::move(body_a), options, std::move(features), plan, progress);
     run.bind_report = binding.bind_report();
     return run.bodies(
@@ -302,18 +309,23 @@ int run(ResizeArgs a) {
   for (const auto& w : run.garment_warnings) std::fprintf(stderr, "refit: warning: %s\n", w.c_str());
   std::vector<FeatureSpec> features;
   if (!a.features.empty()) features = read_feature_file(a.features, a.units);
+  std::optional<PatternWriter> patterns;  // cut on the original garment, once
+  if (!a.patterns.dir.empty()) patterns.emplace(garment, features, a.garment, a.features, with_units(a.patterns, a.units));
   const GarmentBinding binding(garment, std::move(body_a), options, std::move(features), progress);
   run.bind_report = binding.bind_report();
-  return run.bodies(
+  const int status = run.bodies(
       [&](const BodyMesh& body_b, const std::string& out) {
         ResizeResult r = binding.resize(body_b, progress);
         Stopwatch write;
         progress.stage("writing " + out);
         ObjWriteReport written = write_garment_obj(out, *garment, r.positions);
+        if (patterns) r.report["patterns"] = patterns->write(body_b.name, r.positions, true);
         r.report["timings_ms"]["write"] = write.ms();
         return BodyResult{std::move(r.report), std::move(r.warnings), std::move(written), std::move(r.features)};
       },
       folder);
+  if (patterns_folder) patterns_folder->keep();
+  return status;
 }
 
 // Switches that change the method or the solver: a help section of their own.
@@ -346,6 +358,9 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
                  "eq. 4 blend, no zone, layers, smoothing, symmetry or collision, Gauss-Seidel sweeps; docs/method.md)")
       ->check(CLI::IsMember({"refit", "paper"}))
       ->capture_default_str();
+  app.add_option("--patterns-out", a->patterns.dir,
+                 "Folder for each result's 2D patterns and grading view against the original (BODY.svg, .dxf, .json, "
+                 "-grading.svg; seam curves of --features cut; docs/patterns.md)");
   app.add_option("--curves-out", a->curves_out, "Write original, warped and optimised feature curves (OBJ l lines)");
   app.add_flag("--paper-closeness", a->paper_closeness,
                "Feature closeness term as the paper's plain sums (weak: keeps most of the warp's bend)")

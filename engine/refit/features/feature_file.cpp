@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <set>
 #include <sstream>
 
@@ -97,7 +98,13 @@ FeatureSpec parse_feature(const json& f, std::size_t index, const Ctx& root) {
   if (!name.is_string() || name.get<std::string>().empty()) c.fail("'name' must be a non-empty string");
   s.name = name.get<std::string>();
   c.who = "feature '" + s.name + "'";
-  check_keys(f, {"name", "plane", "curve", "samples", "comment"}, c, "the feature");
+  check_keys(f, {"name", "plane", "curve", "samples", "role", "comment"}, c, "the feature");
+  if (f.contains("role")) {
+    const json& role = f["role"];
+    if (!role.is_string() || (role.get<std::string>() != "shape" && role.get<std::string>() != "seam"))
+      c.fail("'role' must be \"shape\" or \"seam\", got " + role.dump());
+    s.role = role.get<std::string>() == "seam" ? CurveRole::seam : CurveRole::shape;
+  }
 
   const json& curve = require(f, "curve", c, "the feature");
   if (!curve.is_object()) c.fail("'curve' must be an object");
@@ -114,6 +121,8 @@ FeatureSpec parse_feature(const json& f, std::size_t index, const Ctx& root) {
     c.fail("unknown curve kind '" + k + "' (expected bspline, slice or boundary)");
   }
 
+  if (s.role == CurveRole::seam && s.kind == CurveKind::boundary)
+    c.fail("a seam cannot be a boundary curve (the garment is already cut along its boundary)");
   if (f.contains("plane")) s.plane = parse_plane(f["plane"], c);
   else if (s.kind != CurveKind::boundary) c.fail("missing 'plane' (required for a " + k + " curve)");
 
@@ -192,6 +201,8 @@ const char* to_string(CurveKind kind) {
   return "?";
 }
 
+const char* to_string(CurveRole role) { return role == CurveRole::seam ? "seam" : "shape"; }
+
 double metres_per_unit(const std::string& units, const std::string& file) {
   if (units == "cm") return 0.01;
   if (units == "mm") return 0.001;
@@ -240,6 +251,12 @@ std::vector<FeatureSpec> parse_feature_json(const std::string& text, const std::
     if (!names.insert(out.back().name).second)
       throw input_error(file, "feature '" + out.back().name + "': the name is used twice");
   }
+  return out;
+}
+
+std::vector<FeatureSpec> features_with_role(const std::vector<FeatureSpec>& specs, CurveRole role) {
+  std::vector<FeatureSpec> out;
+  std::copy_if(specs.begin(), specs.end(), std::back_inserter(out), [&](const FeatureSpec& s) { return s.role == role; });
   return out;
 }
 

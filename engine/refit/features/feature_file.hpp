@@ -13,7 +13,10 @@
 //                 { "kind": "slice", "near": [x,y,z], "from": [x,y,z], "to": [x,y,z],
 //                   "control_points": 12 }  (from, to optional; control_points default 12)
 //                 { "kind": "boundary", "near": [x,y,z] },
-//        "samples": 80 } ] }               required; >= 5 open, >= 3 closed
+//        "samples": 80,                     required; >= 5 open, >= 3 closed
+//        "role": "shape" } ] }               optional: "shape" (default) keeps its shape in a
+//                                            resize; "seam" is where the garment is cut into
+//                                            pattern pieces (not a boundary; ignored by resize)
 //
 // Coordinates are converted from the file's "units" (cm, mm, m, in) to the
 // garment's units. Unknown keys are refused (they are usually typos).
@@ -27,13 +30,18 @@
 namespace refit {
 
 enum class CurveKind { bspline, slice, boundary };
+/// What a curve is for: a shape to keep (paper section 4) or a seam line along
+/// which the garment is cut into pattern pieces (refit/patterns).
+enum class CurveRole { shape, seam };
 
 const char* to_string(CurveKind kind);
+const char* to_string(CurveRole role);
 
 struct FeatureSpec {
   std::string name;
   std::string file;  // the feature file, for messages ("" when parsed from text without one)
   CurveKind kind = CurveKind::bspline;
+  CurveRole role = CurveRole::shape;
   std::optional<FeaturePlane> plane;  // absent only for boundary (then the loop's PCA plane)
   std::size_t samples = 0;
   // bspline
@@ -57,6 +65,10 @@ double metres_per_unit(const std::string& units, const std::string& file = "");
 /// too few samples or control points, duplicate names.
 std::vector<FeatureSpec> parse_feature_json(const std::string& text, const std::string& file,
                                             const std::string& garment_units = "cm");
+
+/// The specs of one role, in file order (a resize keeps the shapes; the
+/// pattern maker cuts along the seams).
+std::vector<FeatureSpec> features_with_role(const std::vector<FeatureSpec>& specs, CurveRole role);
 
 /// Reads and parses a feature file (see parse_feature_json); throws refit::Error
 /// when it cannot be read.

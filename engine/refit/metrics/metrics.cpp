@@ -239,8 +239,9 @@ ResizeMetrics compute_metrics(const Garment& original, const Points& result, con
 std::vector<FeatureCurveInput> feature_curve_inputs(const Garment& original, const Points& result, const BodyMesh& a,
                                                     const BodyMesh& b, const std::vector<FeatureSpec>& specs) {
   std::vector<FeatureCurveInput> inputs;
-  if (specs.empty()) return inputs;
-  const std::vector<FeatureCurve> curves = build_feature_curves(original, specs);
+  const std::vector<FeatureSpec> shapes = features_with_role(specs, CurveRole::shape);
+  if (shapes.empty()) return inputs;
+  const std::vector<FeatureCurve> curves = build_feature_curves(original, shapes);
   const ReferenceBody ref(a);
   const TriangleFrames frames_b = compute_frames(b);
   for (const auto& c : curves) {

@@ -30,6 +30,7 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
     : garment_(std::move(garment)),
       options_(std::move(options)),
       body_a_((check_body(body_a), std::move(body_a)), options_.warp) {
+  features = features_with_role(features, CurveRole::shape);  // seams only cut patterns (refit/patterns)
   const double per_cm = units_per_cm(options_.units);
   if (garment_->vertex_count() == 0) throw Error("garment: empty garment (no vertices)");
   if (!garment_->positions.allFinite()) throw Error("garment: a vertex position is NaN or infinite");

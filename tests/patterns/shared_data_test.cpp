@@ -1,0 +1,149 @@
+// Patterns of the real MakeHuman garments (issue 16), skipped when ../shared/data
+// is absent. Asserts what holds today: every garment flattens with no face of a
+// piece of 100 faces or more turned over; the skirt's and the jeans' pieces keep
+// their 3D area within 1 %, the dress's and the suit's (curved over bust, seat
+// and shoulders) within 6 %; the sewn edges of the skirt, the jeans (cut into
+// front and back pieces by bench/quality/features/jeans.json) and the dress agree
+// within 0.5 %; the DXF of the jeans reads back (ezdxf) with the report's pieces
+// and lengths; the feature lines of the resized patterns are closer to their
+// original pattern shape after the full pipeline than after the warp alone.
+// Prints the stretch of every garment (issue 16's 0.02 is not reached: about
+// 0.09 on skirt and jeans) and the straightness ratios of the paper's claim
+// (Fig. 10), whose 3x target is not reached on the jeans (docs/patterns.md).
+#include "support/test_support.hpp"
+
+#include <refit/features/feature_file.hpp>
+#include <refit/io/body_io.hpp>
+#include <refit/io/obj_garment.hpp>
+#include <refit/patterns/grading.hpp>
+#include <refit/patterns/pattern.hpp>
+#include <refit/pipeline/resize.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+
+namespace refit {
+namespace {
+
+std::string data(const std::string& rel) { return test::shared_data_dir() + "/" + rel; }
+std::string features(const std::string& garment) {
+  return std::string(REFIT_SOURCE_DIR) + "/bench/quality/features/" + garment + ".json";
+}
+
+struct Case {
+  const char* garment;
+  const char* file;
+  const char* features;  // a feature file of bench/quality/features, or nullptr
+  bool seams_agree;      // sewn edges within 0.5 % is asserted
+  double area_change;    // largest |2D area / 3D area - 1| of a piece of 100 faces or more (measured, rounded up)
+};
+
+TEST(SharedPatterns, EveryGarmentFlattensAndTheSeamsAgree) {
+  if (test::shared_data_dir().empty()) GTEST_SKIP() << "../shared/data is absent";
+  const Case cases[] = {{"skirt", "garments/skirt_on_A_female.obj", nullptr, true, 0.01},
+                        {"jeans", "garments/jeans_on_A_female.obj", "jeans", true, 0.01},
+                        {"dress", "garments/dress_on_A_female.obj", nullptr, true, 0.06},
+                        {"male_suit", "garments/male_suit_on_M_ref.obj", "male_suit", false, 0.06},
+                        {"outfit_dress_jeans", "garments/outfit_dress_jeans_on_A_female.obj", nullptr, true, 0.06},
+                        {"dress_soup", "garments/dress_soup_on_A_female.obj", nullptr, false, 0.06}};
+  std::printf("| garment | panels | stretch p95 (faces) | worst panel p95 | seams | worst seam mismatch |\n");
+  for (const Case& c : cases) {
+    const Garment g = read_garment_obj(data(c.file));
+    const std::vector<FeatureSpec> specs = c.features ? read_feature_file(features(c.features)) : std::vector<FeatureSpec>{};
+    const PatternCut cut = cut_pattern(g, specs, c.file);
+    PatternOptions options;
+    options.skip_unflattenable = true;
+    const Pattern p = flatten_pattern(g, cut, g.positions, options);
+    double worst_piece = 0;
+    for (std::size_t k = 0; k < p.pieces.size(); ++k) {
+      const PatternPiece& piece = p.pieces[k];
+      ASSERT_TRUE(piece.flattened) << c.garment << " " << cut.panels.panels[k].name;
+      worst_piece = std::max(worst_piece, piece.measures.stretch_p95);
+      // Pieces of a few faces are buttons and tabs (the suit's) that no flattening keeps.
+      if (cut.panels.panels[k].faces.size() >= 100) {
+        EXPECT_EQ(piece.measures.flipped, 0u) << c.garment << " " << cut.panels.panels[k].name;
+        EXPECT_LT(std::abs(piece.measures.area_2d / piece.measures.area_3d - 1), c.area_change) << c.garment << " " << k;
+      }
+    }
+    if (c.seams_agree) {
+      for (std::size_t i = 0; i < p.seams.size(); ++i)
+        EXPECT_LE(p.seams[i].mismatch, 0.005) << c.garment << " seam " << i << " between "
+                                              << cut.panels.panels[cut.panels.seams[i].panel[0]].name << " and "
+                                              << cut.panels.panels[cut.panels.seams[i].panel[1]].name;
+    }
+    std::printf("| %s | %zu | %.4f | %.4f | %zu | %.4f |\n", c.garment, cut.panels.panels.size(), p.stretch_p95,
+                worst_piece, p.seams.size(), p.seam_mismatch_max);
+  }
+}
+
+TEST(SharedPatterns, JeansDxfReadsBackWithTheSamePieces) {
+  if (test::shared_data_dir().empty()) GTEST_SKIP() << "../shared/data is absent";
+  test::TempDir dir;
+  const auto r = test::run_cli("flatten --garment '" + data("garments/jeans_on_A_female.obj") + "' --features '" +
+                               features("jeans") + "' --out-dir '" + dir.path().string() + "' --name jeans --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto dxf = test::run_shell("/usr/bin/python3 '" REFIT_SOURCE_DIR "/tests/patterns/read_dxf.py' '" +
+                                   dir.file("jeans.dxf") + "'");
+  if (dxf.exit_code == 77) GTEST_SKIP() << dxf.out;
+  ASSERT_EQ(dxf.exit_code, 0) << dxf.err;
+  const nlohmann::json back = nlohmann::json::parse(dxf.out);
+  const nlohmann::json report = nlohmann::json::parse(test::read_text(dir.file("jeans.json")));
+  std::vector<double> want, got;
+  for (const auto& p : report["panels"])
+    for (const auto& l : p["outline_lengths"]) want.push_back(l.get<double>());
+  for (const auto& p : back["polylines"]["CUT"]) got.push_back(p["length"].get<double>());
+  std::sort(want.begin(), want.end());
+  std::sort(got.begin(), got.end());
+  ASSERT_EQ(want.size(), 4u);  // front and back of each leg
+  ASSERT_EQ(got.size(), want.size());
+  for (std::size_t i = 0; i < got.size(); ++i) EXPECT_NEAR(got[i], want[i], 1e-5 * want[i]);
+  EXPECT_EQ(back["polylines"]["FEATURES"].size(), 4u);  // the creases
+}
+
+// The paper's claim (section 6, Fig. 10): patterns of the resized trousers have
+// fewer S-shaped distortions along the feature curves after the full pipeline
+// than after the warp alone.
+TEST(SharedPatterns, FullPipelinePatternLinesAreStraighterThanTheWarps) {
+  if (test::shared_data_dir().empty()) GTEST_SKIP() << "../shared/data is absent";
+  struct Claim {
+    const char* garment;
+    const char* body_a;
+    const char* body_b;
+  };
+  const Claim claims[] = {{"jeans", "A_female", "F_heavier"},
+                          {"jeans", "A_female", "F_thinner"},
+                          {"male_suit", "M_ref", "M_heavier"}};
+  std::printf("| garment | body | warp straightness (mean) | full | warp / full | worst line warp / full |\n");
+  for (const Claim& c : claims) {
+    auto g = std::make_shared<const Garment>(
+        read_garment_obj(data(std::string("garments/") + c.garment + "_on_" + c.body_a + ".obj")));
+    const std::vector<FeatureSpec> specs = read_feature_file(features(c.garment));
+    const BodyMesh b = read_body(data(std::string("bodies/") + c.body_b + ".obj"));
+    const PatternCut cut = cut_pattern(*g, specs, c.garment);
+    PatternOptions options;
+    options.skip_unflattenable = true;  // the suit's jacket has pieces that no flattening keeps; the trousers are graded
+    const Pattern original = flatten_pattern(*g, cut, g->positions, options);
+    std::array<Grading, 2> grading;
+    for (int full = 0; full < 2; ++full) {
+      ResizeOptions ro;
+      ro.stage = full ? Stage::Full : Stage::Warp;
+      const GarmentBinding binding(g, read_body(data(std::string("bodies/") + c.body_a + ".obj")), ro, specs);
+      const ResizeResult r = binding.resize(b);
+      grading[full] = grade_pattern(*g, cut, original, flatten_pattern(*g, cut, r.positions, options));
+    }
+    ASSERT_EQ(grading[0].lines, 4u);
+    double worst = 1e30;
+    for (std::size_t k = 0; k < grading[0].pieces.size(); ++k)
+      for (std::size_t i = 0; i < grading[0].pieces[k].lines.size(); ++i)
+        worst = std::min(worst, grading[0].pieces[k].lines[i].deviation / grading[1].pieces[k].lines[i].deviation);
+    const double ratio = grading[0].deviation_mean / grading[1].deviation_mean;
+    std::printf("| %s | %s | %.5f | %.5f | %.2f | %.2f |\n", c.garment, c.body_b, grading[0].deviation_mean,
+                grading[1].deviation_mean, ratio, worst);
+    EXPECT_GT(ratio, 1.15) << c.garment << " to " << c.body_b;
+  }
+}
+
+}  // namespace
+}  // namespace refit

@@ -1,0 +1,107 @@
+// Pattern files of a garment state; see patterns_output.hpp.
+#include "patterns_output.hpp"
+
+#include "report_file.hpp"
+
+#include <refit/core/error.hpp>
+#include <refit/io/atomic_file.hpp>
+#include <refit/patterns/dxf.hpp>
+#include <refit/patterns/grading.hpp>
+#include <refit/patterns/report.hpp>
+#include <refit/patterns/svg.hpp>
+
+#include <filesystem>
+
+namespace refit::cli {
+namespace {
+
+void write_text(const std::string& path, const std::string& text) {
+  write_file_atomically(path, [&](std::ostream& out) { out << text; });
+}
+
+}  // namespace
+
+void add_pattern_options(CLI::App& app, PatternsOptions& o, const std::string& advanced) {
+  app.add_option("--sheet-units", o.sheet_units, "Units of the SVG: cm or mm (true scale either way)")
+      ->check(CLI::IsMember({"cm", "mm"}))
+      ->capture_default_str();
+  app.add_flag("--stretch-map", o.stretch_map, "Colour the SVG's pieces by their stretch against 3D");
+  app.add_flag("--skip-unflattenable", o.skip_unflattenable,
+               "Leave out panels that cannot be flattened (with a warning) instead of failing");
+  app.add_option("--boundary-weight", o.flatten.boundary_weight,
+                 "Weight that keeps the pieces' outlines at their 3D length (0 = plain ARAP; seams then agree less)")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str()
+      ->group(advanced);
+  app.add_option("--conformal-iterations", o.flatten.conformal_iterations,
+                 "Conjugate-gradient iterations of the conformal start, at most")
+      ->check(CLI::Range(0, 100000))
+      ->capture_default_str()
+      ->group(advanced);
+  app.add_option("--arap-iterations", o.flatten.max_iterations, "ARAP iterations per piece, at most")
+      ->check(CLI::Range(0, 100000))
+      ->capture_default_str()
+      ->group(advanced);
+  app.add_option("--arap-tolerance", o.flatten.tolerance,
+                 "ARAP stops when an iteration lowers the energy by less than this fraction")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str()
+      ->group(advanced);
+}
+
+std::vector<std::string> pattern_paths(const std::string& dir, const std::string& name, bool grading) {
+  const std::filesystem::path base = std::filesystem::path(dir) / name;
+  std::vector<std::string> out = {base.string() + ".svg", base.string() + ".dxf", base.string() + ".json"};
+  if (grading) out.push_back(base.string() + "-grading.svg");
+  return out;
+}
+
+PatternWriter::PatternWriter(std::shared_ptr<const Garment> original, const std::vector<FeatureSpec>& specs,
+                             const std::string& garment_file, const std::string& features_file, PatternsOptions options)
+    : garment_(std::move(original)), options_(std::move(options)) {
+  pattern_options_.skip_unflattenable = options_.skip_unflattenable;
+  pattern_options_.flatten = options_.flatten;
+  pattern_options_.margin = 2.0 / (100.0 * metres_per_unit(options_.units));  // 2 cm
+  cut_ = cut_pattern(*garment_, specs, garment_file, features_file);
+}
+
+const Pattern& PatternWriter::original_pattern() const {
+  if (!original_) original_ = flatten_pattern(*garment_, cut_, garment_->positions, pattern_options_);
+  return *original_;
+}
+
+nlohmann::json PatternWriter::write(const std::string& name, const Points& positions, bool grade) const {
+  const Pattern pattern = flatten_pattern(*garment_, cut_, positions, pattern_options_);
+  const double cm_per_unit = 100.0 * metres_per_unit(options_.units);
+  const std::vector<std::string> paths = pattern_paths(options_.dir, name, grade);
+  nlohmann::json report = pattern_report(*garment_, cut_, pattern, positions, options_.units);
+  OutputBatch batch;  // the files of one state appear together
+  write_text(paths[0], sheet_svg(pattern_sheet(*garment_, cut_, pattern, options_.stretch_map), cm_per_unit,
+                                 options_.sheet_units));
+  write_text(paths[1], sheet_dxf(pattern_sheet(*garment_, cut_, pattern), options_.units));
+  if (grade) {
+    const Pattern& before = original_pattern();
+    const Grading grading = grade_pattern(*garment_, cut_, before, pattern);
+    report["grading"] = grading_report(grading);
+    report["grading"]["original"] = {{"stretch_p95", before.stretch_p95}, {"seam_mismatch_max", before.seam_mismatch_max}};
+    write_text(paths[3], sheet_svg(grading_sheet(*garment_, cut_, before, pattern, grading, pattern_options_.margin),
+                                   cm_per_unit, options_.sheet_units));
+  }
+  write_json_report(paths[2], report);
+  batch.commit();
+  nlohmann::json summary = {{"svg", paths[0]},
+                            {"dxf", paths[1]},
+                            {"report", paths[2]},
+                            {"panels", cut_.panels.panels.size()},
+                            {"stretch_p95", pattern.stretch_p95},
+                            {"seam_mismatch_max", pattern.seam_mismatch_max},
+                            {"warnings", pattern.warnings}};
+  if (grade) {
+    summary["grading_svg"] = paths[3];
+    summary["straightness_mean"] = report["grading"]["straightness_mean"];
+    summary["straightness_max"] = report["grading"]["straightness_max"];
+  }
+  return summary;
+}
+
+}  // namespace refit::cli
