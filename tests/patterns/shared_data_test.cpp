@@ -9,7 +9,8 @@
 // original pattern shape after the full pipeline than after the warp alone.
 // Prints the stretch of every garment (issue 16's 0.02 is not reached: about
 // 0.09 on skirt and jeans) and the straightness ratios of the paper's claim
-// (Fig. 10), whose 3x target is not reached on the jeans (docs/patterns.md).
+// (Fig. 10), whose 3x target is reached on the suit's trousers resized to F_heavier
+// and F_thinner (asserted), not on the jeans (docs/patterns.md).
 #include "support/test_support.hpp"
 
 #include <refit/features/feature_file.hpp>
@@ -104,17 +105,21 @@ TEST(SharedPatterns, JeansDxfReadsBackWithTheSamePieces) {
 
 // The paper's claim (section 6, Fig. 10): patterns of the resized trousers have
 // fewer S-shaped distortions along the feature curves after the full pipeline
-// than after the warp alone.
+// than after the warp alone; issue 16 asks for 3x on the jeans or the suit's
+// trousers resized to F_heavier and F_thinner.
 TEST(SharedPatterns, FullPipelinePatternLinesAreStraighterThanTheWarps) {
   if (test::shared_data_dir().empty()) GTEST_SKIP() << "../shared/data is absent";
   struct Claim {
     const char* garment;
     const char* body_a;
     const char* body_b;
+    double at_least;  // warp / full: issue 16's 3x where it is reached, else "closer" with a margin
   };
-  const Claim claims[] = {{"jeans", "A_female", "F_heavier"},
-                          {"jeans", "A_female", "F_thinner"},
-                          {"male_suit", "M_ref", "M_heavier"}};
+  const Claim claims[] = {{"jeans", "A_female", "F_heavier", 1.15},
+                          {"jeans", "A_female", "F_thinner", 1.15},
+                          {"male_suit", "M_ref", "M_heavier", 1.15},
+                          {"male_suit", "M_ref", "F_heavier", 3.0},
+                          {"male_suit", "M_ref", "F_thinner", 3.0}};
   std::printf("| garment | body | warp straightness (mean) | full | warp / full | worst line warp / full |\n");
   for (const Claim& c : claims) {
     auto g = std::make_shared<const Garment>(
@@ -141,7 +146,7 @@ TEST(SharedPatterns, FullPipelinePatternLinesAreStraighterThanTheWarps) {
     const double ratio = grading[0].deviation_mean / grading[1].deviation_mean;
     std::printf("| %s | %s | %.5f | %.5f | %.2f | %.2f |\n", c.garment, c.body_b, grading[0].deviation_mean,
                 grading[1].deviation_mean, ratio, worst);
-    EXPECT_GT(ratio, 1.15) << c.garment << " to " << c.body_b;
+    EXPECT_GE(ratio, c.at_least) << c.garment << " to " << c.body_b;
   }
 }
 
