@@ -61,6 +61,22 @@ TEST(ChunkedCli, BudgetsAboveTheEstimateRunInMemoryAndTooSmallOnesAreRefused) {
   EXPECT_THAT(bad.err, HasSubstr("--memory-budget: '12parsecs' is not a size"));
 }
 
+TEST(ChunkedCli, TheCollisionStepIsRefusedBeforeAnyWorkNotSkipped) {
+  const std::string data = test::shared_data_dir();
+  if (data.empty()) GTEST_SKIP() << "../shared/data is absent: the chunked mode's command-line test skipped";
+  test::TempDir dir;
+  const test::CommandResult r =
+      test::run_cli("resize --garment " + data + "/garments/skirt_on_A_female.obj --from " + data + "/bodies/A_female.obj --to " +
+                    data + "/bodies/F_heavier.obj --chunk-vertices 100 --out " + dir.file("out.obj"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_THAT(r.err, HasSubstr("the chunked mode does not do the collision step yet (use --no-collision)"));
+  EXPECT_THAT(r.err, ::testing::Not(HasSubstr("reading")));  // refused before the garment is read in chunks
+  EXPECT_FALSE(std::filesystem::exists(dir.file("out.obj")));
+  // A small garment is never counted for the automatic choice; a missing one is left to the reader.
+  EXPECT_FALSE(might_exceed_memory(data + "/garments/skirt_on_A_female.obj"));
+  EXPECT_FALSE(might_exceed_memory(dir.file("missing.obj")));
+}
+
 TEST(ChunkPlan, ChunksAboveTheInMemoryEstimateWithinTheBudget) {
   // The dense dress at 17M vertices (the densified dress of bench/chunked.sh) in 1 GB.
   const GarmentSize dress{2'800'000'000, 17'177'471, 34'340'864};

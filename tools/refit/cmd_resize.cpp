@@ -264,9 +264,7 @@ int run(ResizeArgs a) {
   GarmentSize size;
   // The garment's sizes from its first pass when the choice needs them (a
   // budget, or a file large enough that the in-memory run might not fit).
-  std::error_code size_error;
-  const std::size_t file_bytes = std::filesystem::file_size(a.garment, size_error);
-  if (chunking.memory_budget > 0 || chunking.chunk_vertices > 0 || (!size_error && might_exceed_memory(file_bytes))) {
+  if (chunking.memory_budget > 0 || chunking.chunk_vertices > 0 || might_exceed_memory(a.garment)) {
     progress.stage("counting " + a.garment);
     obj.emplace(a.garment);
     size = {obj->bytes(), obj->vertex_count(), obj->face_count()};
@@ -277,7 +275,15 @@ int run(ResizeArgs a) {
       estimated_memory_mb(size.vertices, options.stage == Stage::Full ? estimated_agents(size.vertices, so.agent_budget, so.voxel) : 0.0,
                           body_a.triangles.size());
   if (obj && use_chunks(size, chunking, in_memory_mb)) {
-    check_chunked_options(options);
+    try {
+      check_chunked_options(options);
+    } catch (const Error& e) {  // say why the run is chunked: the user may not have asked for it
+      const std::string why = a.chunk_vertices > 0 ? "--chunk-vertices asks for the chunked mode"
+                              : "its in-memory run (about " + std::to_string(long(in_memory_mb)) + " MB) is above " +
+                                    (chunking.memory_budget > 0 ? "--memory-budget " + a.memory_budget : "this machine's memory") +
+                                    ", so it is resized in chunks";
+      throw input_error(a.garment, why + ", and " + e.what());
+    }
     if (!a.patterns.dir.empty()) throw Error("--patterns-out works in memory only, not in chunks (give no --memory-budget or --chunk-vertices, or run refit flatten on the result)");
     const ChunkPlan plan = plan_chunks(size, chunking);
     progress.stage("reading " + a.garment + " into " + plan.folder.string() + " in chunks of " +

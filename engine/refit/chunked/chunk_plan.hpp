@@ -30,9 +30,10 @@ struct GarmentSize {
 /// the binding refuses a voxel size that would make far more).
 double estimated_agents(std::size_t vertices, std::size_t agent_budget, double voxel);
 
-/// Whether a garment file of this size could need more memory than this
-/// machine has in memory (then its vertices are counted before choosing).
-bool might_exceed_memory(std::size_t file_bytes);
+/// Whether the garment in `file` could need more memory than this machine has
+/// in memory (then its vertices are counted before choosing), from the density
+/// of vertex lines at its start; false for a file that cannot be read.
+bool might_exceed_memory(const std::filesystem::path& file);
 
 struct ChunkPlan {
   std::size_t chunk_vertices = 0;  // vertices per chunk
