@@ -498,6 +498,25 @@ ClosestPoint BodySurface::closest_within(const Vec3& p, double max_distance) con
   return r;
 }
 
+SignedClosestPoint BodySurface::signed_closest_within(const Vec3& p, double max_distance) const {
+  SignedClosestPoint r;
+  if (!p.allFinite()) {
+    r.distance = kInf;
+    return r;
+  }
+  const PointQueryData d = impl_->query(p, max_distance);
+  if (!std::isfinite(d.best_d2)) {
+    r.distance = kInf;
+    return r;
+  }
+  r.point = d.point;
+  r.normal = row3(impl_->face_normal, d.tri);
+  r.distance = std::sqrt(d.best_d2);
+  r.triangle = d.tri;
+  r.inside = impl_->inside_given(d);
+  return r;
+}
+
 void BodySurface::prepare_inside_test() const { impl_->ensure_grid(); }
 
 bool BodySurface::inside(const Vec3& p) const {

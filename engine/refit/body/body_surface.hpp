@@ -14,6 +14,11 @@ struct ClosestPoint {
   Index triangle = 0;
 };
 
+/// A closest point and, when one was found, whether the query point is inside.
+struct SignedClosestPoint : ClosestPoint {
+  bool inside = false;  // decided as inside() does; false (and meaningless) when distance is +inf
+};
+
 /// Closest point to p on triangle abc (exact, in double).
 Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
 
@@ -27,6 +32,11 @@ class BodySurface {
   ClosestPoint closest(const Vec3& p) const;
   /// Closest point no farther than max_distance; distance = +inf when none.
   ClosestPoint closest_within(const Vec3& p, double max_distance) const;
+  /// closest_within() and, when a point was found, inside() from the same query:
+  /// within about 1 cm of the surface the closest feature's pseudonormal decides, so
+  /// one point query answers both. Nothing within max_distance: distance = +inf
+  /// and `inside` is not decided (prove the point outside or call inside()).
+  SignedClosestPoint signed_closest_within(const Vec3& p, double max_distance) const;
   /// True when p is inside the closed body (ray parity, majority over several directions).
   bool inside(const Vec3& p) const;
   /// Builds the inside test's lookup grid now; otherwise the first inside() call

@@ -3,6 +3,7 @@
 #include <refit/features/curve_metrics.hpp>
 #include <refit/features/feature_curves.hpp>
 #include <refit/collision/collision.hpp>
+#include <refit/collision/distance_hold.hpp>
 #include <refit/io/obj_garment.hpp>
 #include <refit/metrics/metrics.hpp>
 #include <refit/pipeline/resize.hpp>
@@ -15,6 +16,19 @@
 #include <optional>
 
 namespace refit {
+
+namespace {
+
+// The corners (with a weight) of the faces the feature samples sit on.
+std::vector<std::uint8_t> feature_corners(const SurfaceAttachment& attachment, Eigen::Index vertices) {
+  std::vector<std::uint8_t> corner(static_cast<std::size_t>(vertices), 0);
+  for (std::size_t k = 0; k < attachment.vertex.size(); ++k)
+    for (int j = 0; j < 3; ++j)
+      if (attachment.weight[k][j] != 0.0) corner[static_cast<std::size_t>(attachment.vertex[k][j])] = 1;
+  return corner;
+}
+
+}  // namespace
 
 nlohmann::json garment_summary(const Garment& g) {
   return {{"vertices", g.vertex_count()},
@@ -111,6 +125,8 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
     } catch (const Error& e) {  // e.g. a voxel size too small for the garment: name its file
       throw input_error(garment_->source ? garment_->source->file : "garment", e.what());
     }
+    if (options_.collision && options_.hold_distance)
+      near_body_a_ = near_body_distances(garment_->positions, BodySurface(body_a_.mesh()), options_.hold_band_cm * per_cm);
     bind_report_["surface"] = clock.ms();
   }
 }
@@ -187,6 +203,13 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
     report["symmetry"]["symmetrised"] = symmetric_b;
   }
 
+  // A symmetric pair gives a symmetric garment: each paired vertex halfway to its partner's mirror image.
+  const auto symmetrise = [&](Points& positions) {
+    const Points mirrored = mirror_x(carry(garment_mirror_, positions), mirror_x_);
+    for (Index i = 0; i < positions.rows(); ++i)
+      if (garment_paired_[i]) positions.row(i) = 0.5 * (positions.row(i) + mirrored.row(i));
+  };
+
   FeatureResult& curves = result.features;
   if (features_) {
     progress.stage("optimising " + std::to_string(features_->model.curves.size()) + " feature curves");
@@ -213,11 +236,7 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
     result.positions = std::move(s.positions);
     // The agents' solve is not exactly mirror-symmetric (its ordering and blends are not):
     // a symmetric pair gives a symmetric garment.
-    if (symmetric_b) {
-      const Points mirrored = mirror_x(carry(garment_mirror_, result.positions), mirror_x_);
-      for (Index i = 0; i < result.positions.rows(); ++i)
-        if (garment_paired_[i]) result.positions.row(i) = 0.5 * (result.positions.row(i) + mirrored.row(i));
-    }
+    if (symmetric_b) symmetrise(result.positions);
     if (s.stats.anchored > 0)
       result.warnings.push_back(std::to_string(s.stats.anchored) + " agents in " + std::to_string(s.stats.anchored_groups) +
                                 " groups with no fixed agent were anchored at their warped positions");
@@ -240,6 +259,21 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
     co.near_band *= per_cm;  // the defaults are in cm
     co.max_lift *= per_cm;
     co.face_clearance *= per_cm;
+    if (!near_body_a_.empty()) {
+      DistanceHoldOptions ho;
+      ho.tolerance *= per_cm;  // the defaults are in cm
+      ho.reach *= per_cm;
+      // The corners of the faces the curves sit on stay where the surface step put them.
+      std::vector<std::uint8_t> pinned;
+      if (!curves.curves.empty()) {
+        pinned = feature_corners(feature_attachment_, result.positions.rows());
+        ho.pinned = &pinned;
+      }
+      report["distance_hold"] = hold_body_distance(*garment_, result.positions, surface_b, near_body_a_, ho).to_json();
+      // Where the body's closest point is not unique (a vertex on the spine's
+      // groove) the hold's direction picks one side.
+      if (symmetric_b) symmetrise(result.positions);
+    }
     const CollisionReport c = resolve_penetrations(*garment_, result.positions, surface_b, co);
     timings["collision"] = clock.ms();
     report["collision"] = c.to_json();

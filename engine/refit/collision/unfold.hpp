@@ -1,0 +1,82 @@
+#pragma once
+// No folds: what the collision step and the distance hold share. A correction
+// (a displacement per region vertex) that would turn a face over is evened out
+// over that face's corners until no face turns.
+#include <refit/core/garment.hpp>
+#include <refit/core/parallel.hpp>
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+namespace refit {
+
+// Newell normal of face f with its region corners displaced by disp.
+template <class SlotOf>
+Vec3 displaced_face_normal(const Garment& g, const Points& positions, std::size_t f, const SlotOf& slot_of,
+                 const std::vector<Vec3>* disp) {
+  const auto face = g.faces.row(f);
+  Vec3 n = Vec3::Zero();
+  auto at = [&](Index v) {
+    Vec3 p = row3(positions, v);
+    if (disp) {
+      const long k = slot_of(v);
+      if (k >= 0) p += (*disp)[std::size_t(k)];
+    }
+    return p;
+  };
+  for (std::size_t i = 0; i < face.size(); ++i) n += at(face[i]).cross(at(face[(i + 1) % face.size()]));
+  return n;
+}
+
+// No folds: a face the correction would turn over (its normal against the one
+// it had) gets each corner's displacement replaced by the mean over its
+// turned-over faces of their corners' mean displacement (a face whose corners
+// all move alike keeps its normal), for up to `passes` passes. Faces the
+// correction does not reach (no region corner) cannot turn.
+template <class SlotOf>
+void unfold(const Garment& g, const Points& positions, const std::vector<Index>& region, const SlotOf& slot_of,
+            int passes, std::vector<Vec3>& disp) {
+  std::vector<Index> faces;  // faces with a corner in the region, ascending
+  for (std::size_t f = 0; f < g.faces.rows(); ++f) {
+    const auto face = g.faces.row(f);
+    if (face.size() >= 3 && std::any_of(face.begin(), face.end(), [&](Index v) { return slot_of(v) >= 0; }))
+      faces.push_back(Index(f));
+  }
+  std::vector<Vec3> before(faces.size());
+  parallel_for(0, faces.size(), 256, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) before[i] = displaced_face_normal(g, positions, faces[i], slot_of, nullptr);
+  });
+  std::vector<std::uint8_t> turned(faces.size());
+  for (int pass = 0; pass < passes; ++pass) {
+    parallel_for(0, faces.size(), 256, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i)
+        turned[i] = before[i].squaredNorm() > 0.0 && displaced_face_normal(g, positions, faces[i], slot_of, &disp).dot(before[i]) <= 0.0;
+    });
+    std::vector<Vec3> sum(region.size(), Vec3::Zero());
+    std::vector<int> count(region.size(), 0);
+    bool any = false;
+    for (std::size_t i = 0; i < faces.size(); ++i) {
+      if (!turned[i]) continue;
+      any = true;
+      const auto face = g.faces.row(faces[i]);
+      Vec3 mean = Vec3::Zero();
+      for (Index v : face) {
+        const long k = slot_of(v);
+        if (k >= 0) mean += disp[std::size_t(k)];
+      }
+      mean /= double(face.size());
+      for (Index v : face) {
+        const long k = slot_of(v);
+        if (k < 0) continue;
+        sum[std::size_t(k)] += mean;
+        ++count[std::size_t(k)];
+      }
+    }
+    if (!any) return;
+    for (std::size_t k = 0; k < region.size(); ++k)
+      if (count[k] > 0) disp[k] = sum[k] / double(count[k]);
+  }
+}
+
+}  // namespace refit
