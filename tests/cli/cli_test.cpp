@@ -119,8 +119,8 @@ TEST(Cli, MethodPaperIsEveryPaperSwitchAtOnce) {
   const std::string profile = c.dir.file("profile.obj"), switches = c.dir.file("switches.obj");
   const std::string mirrored = c.dir.file("mirrored.obj");
   ASSERT_EQ(run_cli(c.resize(profile, feats + "--method paper")).exit_code, 0);
-  ASSERT_EQ(run_cli(c.resize(switches, feats + "--paper-closeness --paper-surface --encode-on-warped --plain-sweeps "
-                                               "--symmetry none --no-collision")).exit_code, 0);
+  ASSERT_EQ(run_cli(c.resize(switches, feats + "--paper-closeness --ordered-features --paper-surface --encode-on-warped "
+                                               "--plain-sweeps --symmetry none --no-collision")).exit_code, 0);
   EXPECT_EQ(test::read_text(profile), test::read_text(switches));
   ASSERT_EQ(run_cli(c.resize(mirrored, feats + "--method paper --symmetry x")).exit_code, 0);
   EXPECT_NE(test::read_text(profile), test::read_text(mirrored));

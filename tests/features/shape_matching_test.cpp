@@ -35,6 +35,13 @@ Points map_rows(const Points& p, Vec3 (*f)(const Vec3&)) {
 
 FeaturePlane plane_z0() { return FeaturePlane::from_point_normal(Vec3::Zero(), Vec3::UnitZ()); }
 
+// The paper's rule: curves one at a time in order, two fixed samples each.
+ShapeMatchingOptions in_order() {
+  ShapeMatchingOptions o;
+  o.joint = false;
+  return o;
+}
+
 }  // namespace
 
 TEST(ShapeMatching, SimilarityCopyIsLeftUnchanged) {
@@ -47,19 +54,25 @@ TEST(ShapeMatching, SimilarityCopyIsLeftUnchanged) {
   const Eigen::RowVector3d t(4, -2, 9);
   auto sim = [&](const Points& p) { return Points(((scale * p * R.transpose()).rowwise() + t).eval()); };
   const Points ws = sim(c.samples);
-  const ShapeModel model = prepare_shape_model({c});
-  const FeatureResult r = match_shapes(model, {ws}, {sim(c.aux)}, [](const Vec3& p) { return std::abs(p.y()); });
-  ASSERT_EQ(r.curves.size(), 1u);
-  const CurveResult& cr = r.curves[0];
-  EXPECT_LT((cr.optimised - ws).cwiseAbs().maxCoeff(), 1e-9);
-  EXPECT_LT(cr.energy_warped, 1e-18);
-  EXPECT_LT(cr.energy_result, 1e-18);
-  EXPECT_LT(cr.shape_error_result, 1e-12);
-  ASSERT_EQ(cr.fixed.size(), 2u);
-  EXPECT_EQ(cr.fixed[0].reason, "body");
-  EXPECT_NE(cr.fixed[0].index, cr.fixed[1].index);
-  // The new plane is the transformed old one, not mirrored.
-  EXPECT_NEAR(cr.plane.normal.dot(R * Vec3::UnitZ()), 1.0, 1e-9);
+  for (const bool joint : {false, true}) {
+    SCOPED_TRACE(joint ? "joint" : "in order");
+    ShapeMatchingOptions o;
+    o.joint = joint;
+    const ShapeModel model = prepare_shape_model({c}, o);
+    const FeatureResult r = match_shapes(model, {ws}, {sim(c.aux)}, [](const Vec3& p) { return std::abs(p.y()); });
+    ASSERT_EQ(r.curves.size(), 1u);
+    const CurveResult& cr = r.curves[0];
+    EXPECT_LT((cr.optimised - ws).cwiseAbs().maxCoeff(), 1e-9);
+    EXPECT_LT(cr.energy_warped, 1e-18);
+    EXPECT_LT(cr.energy_result, 1e-18);
+    EXPECT_LT(cr.shape_error_result, 1e-12);
+    EXPECT_NEAR(cr.scale_result, scale, 1e-9);
+    ASSERT_EQ(cr.fixed.size(), joint ? 1u : 2u);
+    EXPECT_EQ(cr.fixed[0].reason, "body");
+    if (!joint) EXPECT_NE(cr.fixed[0].index, cr.fixed[1].index);
+    // The new plane is the transformed old one, not mirrored.
+    EXPECT_NEAR(cr.plane.normal.dot(R * Vec3::UnitZ()), 1.0, 1e-9);
+  }
 }
 
 TEST(ShapeMatching, Fig6ZigZagKeepsItsAnglesWhenOneEndIsDragged) {
@@ -77,7 +90,7 @@ TEST(ShapeMatching, Fig6ZigZagKeepsItsAnglesWhenOneEndIsDragged) {
   for (Eigen::Index i = 0; i < c.aux.rows(); ++i) wa.row(i) = warp(row3(c.aux, static_cast<Index>(i))).transpose();
   // "Body B" touches the two ends: they are the fixed samples.
   const Vec3 e0 = row3(ws, 0), e1 = row3(ws, m - 1);
-  const FeatureResult r = match_shapes(prepare_shape_model({c}), {ws}, {wa},
+  const FeatureResult r = match_shapes(prepare_shape_model({c}, in_order()), {ws}, {wa},
                                        [&](const Vec3& p) { return std::min((p - e0).norm(), (p - e1).norm()); });
   const CurveResult& cr = r.curves[0];
   ASSERT_EQ(cr.fixed.size(), 2u);
@@ -109,8 +122,8 @@ TEST(ShapeMatching, Fig5CrossingCurvesDependOnOrderAndShareTheCrossing) {
   const auto [wsb, wab] = warped(cb);
   auto dist = [](const Vec3& p) { return std::abs(p.y() + 12.0) + 0.1 * std::abs(p.x()); };
 
-  const ShapeModel ab = prepare_shape_model({ca, cb});
-  const ShapeModel ba = prepare_shape_model({cb, ca});
+  const ShapeModel ab = prepare_shape_model({ca, cb}, in_order());
+  const ShapeModel ba = prepare_shape_model({cb, ca}, in_order());
   ASSERT_EQ(ab.crossings[1].size(), 1u);
   ASSERT_EQ(ba.crossings[1].size(), 1u);
   const FeatureResult rab = match_shapes(ab, {wsa, wsb}, {waa, wab}, dist);
@@ -152,7 +165,7 @@ TEST(ShapeMatching, ACrossingOffTheLaterCurvesPlaneMovesThePlaneNotOneSample) {
   const FeatureCurve ca = make_feature_curve("A", a, false, plane_z0(), {}, 0);
   const FeatureCurve cb =
       make_feature_curve("B", b, false, FeaturePlane::from_point_normal(Vec3(0.3, 0, 0), Vec3::UnitX()), {}, 1);
-  const ShapeModel model = prepare_shape_model({ca, cb});
+  const ShapeModel model = prepare_shape_model({ca, cb}, in_order());
   ASSERT_EQ(model.crossings[1].size(), 1u);
   const Vec3 shift(0.8, 0.0, 0.0);
   const FeatureResult r = match_shapes(model, {a.rowwise() + shift.transpose(), b},

@@ -32,7 +32,8 @@ struct ResizeArgs {
   std::vector<std::string> to_outputs;  // with --to-list: the output of each body of `to`
   std::size_t threads = 0, max_triangles = WarpOptions{}.max_triangles;
   bool quiet = false, metrics = false, paper_closeness = false, no_shape_control = false, no_collision = false,
-       distance_hold = false, encode_on_warped = false, paper_surface = false, plain_sweeps = false, v_cycles = false;
+       distance_hold = false, encode_on_warped = false, paper_surface = false, plain_sweeps = false, v_cycles = false,
+       ordered_features = false;
   SurfaceOptions surface;
   double clearance = 0.2;
   PatternsOptions patterns;  // --patterns-out: the 2D patterns of each result (docs/patterns.md)
@@ -209,6 +210,7 @@ int run(ResizeArgs a) {
   options.warp.max_triangles = a.max_triangles;
   options.surface = a.surface;
   options.shape_matching.sampling_invariant = !(a.paper_closeness || paper);
+  options.shape_matching.joint = !(a.ordered_features || paper);
   options.surface.encode_on_warped = a.encode_on_warped || paper;
   if (a.plain_sweeps || paper) options.surface.multigrid = false;
   if (a.v_cycles) options.surface.krylov = false;
@@ -361,7 +363,7 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
       ->group(kAdvanced);
   app.add_option("--features", a->features, "Feature curves (JSON) whose shape must survive");
   app.add_option("--method", a->method,
-                 "refit: Refit's choices; paper: the paper's (plain feature sums, encoding on the warp, fan frames, "
+                 "refit: Refit's choices; paper: the paper's (curves in order, plain feature sums, encoding on the warp, fan frames, "
                  "eq. 4 blend, no zone, layers, smoothing, symmetry or collision, Gauss-Seidel sweeps; docs/method.md)")
       ->check(CLI::IsMember({"refit", "paper"}))
       ->capture_default_str();
@@ -371,6 +373,10 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
   app.add_option("--curves-out", a->curves_out, "Write original, warped and optimised feature curves (OBJ l lines)");
   app.add_flag("--paper-closeness", a->paper_closeness,
                "Feature closeness term as the paper's plain sums (weak: keeps most of the warp's bend)")
+      ->group(kAdvanced);
+  app.add_flag("--ordered-features", a->ordered_features,
+               "Feature curves one at a time in file order, a later curve's crossings fixed where an earlier one put "
+               "them (the paper) instead of all curves in one solve sharing their meeting samples")
       ->group(kAdvanced);
   app.add_flag("--no-shape-control", a->no_shape_control, "The warp alone (same as --stage warp)");
   app.add_option("--voxel", a->surface.voxel, "Agent voxel size in cm (0 = from the garment size and --agents)")

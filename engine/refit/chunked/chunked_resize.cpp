@@ -242,7 +242,10 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
     if (bound_->features) {
       progress.stage("optimising " + std::to_string(bound_->features->model.curves.size()) + " feature curves");
       curves = optimise_features(*bound_->features, frames_b, distance_b);
-      if (symmetric_b && !bound_->feature_mirror.empty()) symmetrise_curves(curves, bound_->feature_mirror, bound_->mirror_x);
+      if (symmetric_b && !bound_->feature_mirror.empty()) {
+        symmetrise_curves(curves, bound_->feature_mirror, bound_->mirror_x);
+        restore_meetings(bound_->features->model, curves);
+      }
       timings["features"] = clock.ms();
       report["features"] = features_report(curves);
     }
@@ -332,11 +335,11 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
         snap_count += terms.size();
       });
       if (snaps) {
-        // The snap's small solve, then its corrections added chunk by chunk (as apply_feature_snap adds them).
-        FeatureSnap snap = solve_feature_snap(feature_targets, at, snap_vertices, surface.feature_of(), any_weight,
-                                              surface.options().snap_regularisation);
-        if (snap.correction.size() > 0 && snap_count > 0) {
-          // The terms are in vertex order: each chunk takes those of its vertices.
+        // The snap's small solve, then its corrections added chunk by chunk (as
+        // apply_feature_snap adds them), in passes as SurfaceBinding::snap: a pass
+        // that would not lower the gap is not applied; the sample vertices move
+        // by each pass as the garment's do.
+        const auto apply_pass = [&](const FeatureSnap& snap) {
           std::vector<SnapTerm> batch;
           std::size_t next = 0, taken = 0, moved = 0;
           Index previous = std::numeric_limits<Index>::max();
@@ -359,12 +362,35 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
             }
             surfaced->write(first, s);
           });
-          snap.report.vertices_moved = moved;
+          for (auto& [v, sv] : snap_vertices) {
+            if (sv.held || sv.weight.empty()) continue;
+            for (std::size_t q = 0; q < sv.reach.size(); ++q) {
+              const std::int32_t f = surface.feature_of()[sv.reach[q]];
+              if (f >= 0) sv.position += double(sv.weight[q]) * snap.correction.row(f).transpose();
+            }
+          }
+          return moved;
+        };
+        FeatureSnapReport total;
+        const int passes = std::max(1, surface.options().snap_passes);
+        for (int pass = 0; pass < passes; ++pass) {
+          FeatureSnap snap = solve_feature_snap(feature_targets, at, snap_vertices, surface.feature_of(), any_weight,
+                                                surface.options().snap_regularisation);
+          snap.report.gap_after = snapped_gap(snap, feature_targets, at, snap_vertices, surface.feature_of());
+          if (pass == 0) total = snap.report;
+          total.gap_after = snap.report.gap_after;
+          if (!(snap.report.gap_after < snap.report.gap_before)) {
+            total.gap_after = snap.report.gap_before;
+            break;
+          }
+          if (snap.correction.size() > 0 && snap_count > 0) {
+            const std::size_t moved = apply_pass(snap);
+            if (pass == 0) total.vertices_moved = moved;
+          }
         }
-        snap.report.gap_after = snapped_gap(snap, feature_targets, at, snap_vertices, surface.feature_of());
-        st.feature_gap_before_snap = snap.report.gap_before;
-        st.feature_gap = snap.report.gap_after;
-        st.vertices_snapped = snap.report.vertices_moved;
+        st.feature_gap_before_snap = total.gap_before;
+        st.feature_gap = total.gap_after;
+        st.vertices_snapped = total.vertices_moved;
       }
       st.ms.reconstruct = clock.ms();
       timings["surface"] = st.ms.solve + st.ms.reconstruct;

@@ -141,6 +141,8 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     throw Error("penetration resolution: " + std::to_string(positions.rows()) + " positions for a garment of " +
                 std::to_string(g.positions.rows()) + " vertices");
   if (!(options.clearance >= 0.0)) throw Error("penetration resolution: the clearance must be >= 0");
+  if (options.pinned && options.pinned->size() != std::size_t(positions.rows()))
+    throw Error("penetration resolution: the pinned vertex flags do not match the garment");
   const std::size_t n = static_cast<std::size_t>(positions.rows());
   CollisionReport report;
   std::vector<Index> to_check;  // empty in round 1: check everything
@@ -321,6 +323,10 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
         }
       });
     auto enforce = [&](std::size_t k, Vec3& d) {
+      if (options.pinned && (*options.pinned)[region[k]] && !con_at[k]) {
+        d = Vec3::Zero();
+        return;
+      }
       const double lift = d.dot(cap_dir[k]);
       if (lift > cap[k]) d -= (lift - cap[k]) * cap_dir[k];
       if (lift < sink_floor[k]) d += (sink_floor[k] - lift) * cap_dir[k];
@@ -344,6 +350,9 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
       std::swap(disp, next);
     }
     unfold(g, positions, region, slot_of, options.unfold_passes, disp);
+    if (options.pinned)
+      for (std::size_t k = 0; k < m; ++k)
+        if ((*options.pinned)[region[k]] && !con_at[k]) disp[k] = Vec3::Zero();
     parallel_for(0, m, 1024, [&](std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e; ++k) positions.row(region[k]) += disp[k].transpose();
     });

@@ -9,6 +9,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstdint>
+#include <vector>
+
 namespace refit {
 
 struct CollisionOptions {
@@ -20,6 +23,11 @@ struct CollisionOptions {
   double max_lift = 0.1;        // by at most this beyond what they need (0 band: no limit)
   double face_clearance = 0.05; // garment units: what points inside faces keep from body B
   int unfold_passes = 20;       // passes that undo a correction turning a face over (see collision.cpp)
+  /// Per vertex (or null): vertices the spread of other vertices' corrections
+  /// must not move (the corners of the faces the feature curves sit on, so the
+  /// written garment keeps passing through the curves). A pinned vertex that is
+  /// itself inside body B or too close still moves out.
+  const std::vector<std::uint8_t>* pinned = nullptr;
 };
 
 struct CollisionReport {

@@ -41,6 +41,13 @@ double shape_error(const Points& curve, const Points& original, bool closed) {
   return rms / length;
 }
 
+double similarity_scale(const Points& original, const Points& curve) {
+  check_pair(curve, original, 2, "similarity scale");
+  const Eigen::Matrix3Xd src = original.transpose();
+  const Eigen::Matrix3Xd dst = curve.transpose();
+  return Eigen::umeyama(src, dst, true).topLeftCorner<3, 3>().col(0).norm();
+}
+
 double turning_angle_change_deg(const Points& curve, const Points& original, bool closed) {
   check_pair(curve, original, 3, "turning angle");
   const Eigen::Index m = curve.rows();

@@ -12,6 +12,10 @@ namespace refit {
 /// fewer than 2 rows, or the original has zero length.
 double shape_error(const Points& curve, const Points& original, bool closed);
 
+/// Scale of the best similarity (Umeyama) carrying `original` onto `curve`
+/// (same row count, at least 2 rows): how much the curve grew (> 1) or shrank.
+double similarity_scale(const Points& original, const Points& curve);
+
 /// Mean absolute change, in degrees, of the turning angle between consecutive
 /// segments (the unsigned 3D angle between edge i-1 -> i and edge i -> i+1) from
 /// `original` to `curve`. Closed curves wrap. Zero-length edges count as no turn.

@@ -22,8 +22,8 @@ using Coords = Eigen::Matrix<double, Eigen::Dynamic, 2>;
 
 Vec2 rot(const Vec2& d) { return {d.y(), -d.x()}; }  // R = [0 1; -1 0] (section 4.3)
 
-// Nearest point of a polyline to q, starting from the nearest vertex (k-d tree)
-// and checking the edges around it: exact for the densely sampled curves here.
+}  // namespace
+
 PolylinePoint nearest_near_vertex(const PointTree& tree, const Points& poly, bool closed, const Vec3& q) {
   const Index v = tree.nearest(q).first;
   const std::size_t m = static_cast<std::size_t>(poly.rows());
@@ -45,13 +45,16 @@ PolylinePoint nearest_near_vertex(const PointTree& tree, const Points& poly, boo
   return best;
 }
 
+namespace {
+
 Vec3 point_on(const Points& poly, std::size_t segment, double t) {
   const std::size_t m = static_cast<std::size_t>(poly.rows());
   return (1.0 - t) * row3(poly, static_cast<Index>(segment)) + t * row3(poly, static_cast<Index>((segment + 1) % m));
 }
 
-// Eq. 9 at x (2D coordinates), with closeness to xw.
-double energy(const CurveShape& s, const Coords& x, const Coords& xw, const ShapeMatchingOptions& o) {
+}  // namespace
+
+double shape_energy(const CurveShape& s, const Coords& x, const Coords& xw, const ShapeMatchingOptions& o) {
   const double wd = closeness_weight(o, static_cast<std::size_t>(x.rows()));
   const std::size_t m = static_cast<std::size_t>(x.rows());
   auto X = [&](std::size_t i) -> Vec2 { return x.row(static_cast<Eigen::Index>(i)).transpose(); };
@@ -72,10 +75,7 @@ double energy(const CurveShape& s, const Coords& x, const Coords& xw, const Shap
   return o.shape_weight * er + wd * ed;
 }
 
-// The new plane: PCA of warped samples + warped aux; normal sign and in-plane
-// axes follow the best rotation original -> warped (Kabsch), so the 2D frame
-// keeps its handedness and the curve is not mirrored.
-FeaturePlane new_plane(const FeatureCurve& c, const Points& ws, const Points& wa) {
+FeaturePlane warped_feature_plane(const FeatureCurve& c, const Points& ws, const Points& wa) {
   FeaturePlane p = pca_plane(ws, wa);
   const Eigen::Index n = ws.rows() + wa.rows();
   Eigen::Matrix3Xd src(3, n), dst(3, n);
@@ -90,8 +90,6 @@ FeaturePlane new_plane(const FeatureCurve& c, const Points& ws, const Points& wa
   p.axis_v = p.normal.cross(p.axis_u);
   return p;
 }
-
-}  // namespace
 
 double closeness_weight(const ShapeMatchingOptions& o, std::size_t m) {
   const double md = static_cast<double>(m);
@@ -182,7 +180,14 @@ ShapeModel prepare_shape_model(std::vector<FeatureCurve> curves, const ShapeMatc
 }
 
 FeatureResult match_shapes(const ShapeModel& model, const std::vector<Points>& warped_samples,
-                           const std::vector<Points>& warped_aux, const DistanceToBody& distance_to_body_b) {
+                           const std::vector<Points>& warped_aux, const DistanceToBody& distance_to_body_b,
+                           const ClearanceToBody& clearance_to_body_b) {
+  if (model.options.joint) return match_shapes_jointly(model, warped_samples, warped_aux, distance_to_body_b, clearance_to_body_b);
+  return match_shapes_in_order(model, warped_samples, warped_aux, distance_to_body_b);
+}
+
+FeatureResult match_shapes_in_order(const ShapeModel& model, const std::vector<Points>& warped_samples,
+                                    const std::vector<Points>& warped_aux, const DistanceToBody& distance_to_body_b) {
   const std::size_t count = model.curves.size();
   if (warped_samples.size() != count || warped_aux.size() != count)
     throw Error("feature optimisation: warped points given for " + std::to_string(warped_samples.size()) +
@@ -205,7 +210,7 @@ FeatureResult match_shapes(const ShapeModel& model, const std::vector<Points>& w
     r.closed = c.closed;
     r.original = c.samples;
     r.warped = ws;
-    r.plane = new_plane(c, ws, wa);
+    r.plane = warped_feature_plane(c, ws, wa);
     // Crossings are fixed where the earlier curves put them, in 3D. The plane moves
     // along its normal to pass through them (their mean offset): a crossing off the
     // plane is one sample out of the curve's plane, a kink the in-plane shape
@@ -398,8 +403,8 @@ FeatureResult match_shapes(const ShapeModel& model, const std::vector<Points>& w
       for (std::size_t i = 0; i < m; ++i)
         if (col[i] >= 0) x.row(static_cast<Eigen::Index>(i)) += Vec2(sol(2 * col[i]), sol(2 * col[i] + 1)).transpose();
     }
-    r.energy_warped = energy(shape, xw, xw, o);
-    r.energy_result = energy(shape, x, xw, o);
+    r.energy_warped = shape_energy(shape, xw, xw, o);
+    r.energy_result = shape_energy(shape, x, xw, o);
     r.optimised.resize(static_cast<Eigen::Index>(m), 3);
     for (std::size_t i = 0; i < m; ++i)
       r.optimised.row(static_cast<Eigen::Index>(i)) = r.plane.to_3d(x.row(static_cast<Eigen::Index>(i)).transpose()).transpose();
@@ -408,6 +413,8 @@ FeatureResult match_shapes(const ShapeModel& model, const std::vector<Points>& w
     r.shape_error_result = shape_error(r.optimised, r.original, c.closed);
     r.turning_angle_change_warped_deg = turning_angle_change_deg(r.warped, r.original, c.closed);
     r.turning_angle_change_result_deg = turning_angle_change_deg(r.optimised, r.original, c.closed);
+    r.scale_warped = similarity_scale(r.original, r.warped);
+    r.scale_result = similarity_scale(r.original, r.optimised);
     result.curves.push_back(std::move(r));
   }
   return result;
@@ -424,13 +431,13 @@ FeatureBinding bind_features(const ReferenceBody& a, std::vector<FeatureCurve> c
 }
 
 FeatureResult optimise_features(const FeatureBinding& binding, const TriangleFrames& b_frames,
-                                const DistanceToBody& distance_to_body_b) {
+                                const DistanceToBody& distance_to_body_b, const ClearanceToBody& clearance_to_body_b) {
   std::vector<Points> ws, wa;
   for (std::size_t k = 0; k < binding.model.curves.size(); ++k) {
     ws.push_back(binding.samples[k].apply(b_frames));
     wa.push_back(binding.aux[k].apply(b_frames));
   }
-  return match_shapes(binding.model, ws, wa, distance_to_body_b);
+  return match_shapes(binding.model, ws, wa, distance_to_body_b, clearance_to_body_b);
 }
 
 }  // namespace refit

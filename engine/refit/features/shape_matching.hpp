@@ -1,21 +1,39 @@
 #pragma once
 // Step 2: shape matching on feature curves (paper section 4.3, eqs. 5-9, read
-// with DESIGN.md). Per curve, in file order:
+// with DESIGN.md). Per curve:
 //  - the new feature plane is the PCA plane of the warped samples and warped
 //    auxiliary points (its normal's sign and in-plane axes follow the best
 //    rotation from the original to the warped points, so the curve is never
 //    mirrored);
-//  - the warped samples are projected into it (r'_i, 2D);
 //  - E = w_r E_r + w_d E_d (eqs. 7-9) with (alpha, beta) of eqs. 5-6 stored in
 //    the un-normalised frame (e = r_{i+2} - r_{i+1} and R e), so a rotation plus
-//    uniform scaling of the curve costs nothing, is minimised as ONE sparse
-//    linear least-squares problem in the 2m plane coordinates;
-//  - two samples are fixed by the paper's heuristic (the two closest to body B,
-//    the two closest to curves already processed: the two smallest distances
-//    win), and every sample where the curve crosses an earlier curve is fixed
-//    where the earlier curve's optimised polyline put the crossing (the new
-//    plane is moved along its normal to pass through those points);
-//  - closed curves wrap their indices; open curves drop the end terms.
+//    uniform scaling of the curve costs nothing; the energy is quadratic and is
+//    minimised as a sparse linear least-squares problem.
+// Two ways to handle several curves (ShapeMatchingOptions::joint):
+//  - joint (default, beyond the paper; joint_matching.cpp): ALL curves in one
+//    least-squares problem over their 3D samples. A sample where a curve meets
+//    an earlier one (a profile ending on the hem, crossed curves as in Fig. 5)
+//    is not an unknown of its own: it is the point of the earlier curve's
+//    polyline it lies on in the original (plus its original small offset from
+//    it, turned and scaled with that curve), so meeting curves meet by
+//    construction and both keep their shape. Each curve stays in its new plane
+//    (which may move along its normal), its scale and in-plane rotation follow
+//    the similarity that best carries the original samples onto the warped ones
+//    (a weak term: the curve can give where the curves it meets need it, but no
+//    curve floats its own scale), and one sample, the closest to body B, is held
+//    where the warp put it. Samples the solve leaves inside body B or closer
+//    than the clearance are held at the clearance along the body's normal and
+//    the problem is solved again (clearance rounds);
+//  - in order (the paper; match_shapes_in_order below): one curve at a time in
+//    file order; two samples are fixed by the paper's heuristic (the two closest
+//    to body B, the two closest to curves already processed: the two smallest
+//    distances win), and every sample where the curve crosses an earlier curve
+//    is fixed where the earlier curve's optimised polyline put the crossing (the
+//    new plane is moved along its normal to pass through those points); each
+//    curve is solved in 2D in its plane.
+// Closed curves wrap their indices; open curves drop the end terms.
+#include <refit/body/centre_tree.hpp>
+#include <refit/features/bspline.hpp>
 #include <refit/features/feature_curves.hpp>
 #include <refit/warp/warp.hpp>
 
@@ -45,6 +63,20 @@ struct ShapeMatchingOptions {
   double min_fixed_separation = 0.25;
   double crossing_tolerance = 1.0; // a later sample within this many sample spacings (the larger of the
                                    // two curves') of an earlier curve, in the original, is a crossing
+  /// All curves in one solve, meeting curves sharing their meeting samples (see
+  /// above). False: the paper's order-based rule (`--method paper`).
+  bool joint = true;
+  /// Joint solve: weight of the term that ties each curve's scale and in-plane
+  /// rotation to the similarity fitted from its original to its warped samples
+  /// (dimensionless, like w_r and w_d: see joint_matching.cpp).
+  double scale_weight = 0.01;
+  /// Joint solve: weight of the term that keeps each curve in its new plane.
+  double plane_weight = 1e3;
+  /// Joint solve: samples end at least this far outside body B (garment units; 0:
+  /// no clearance rounds). The pipeline passes the collision clearance plus a
+  /// margin, so the collision step finds nothing to move on the curves.
+  double clearance = 0.0;
+  int clearance_rounds = 6;
 };
 
 /// The weight actually applied to the raw sum of eq. 8 for a curve of m samples
@@ -92,11 +124,13 @@ struct FixedSample {
 
 struct CurveResult {
   std::string name;
+  double scale_warped = 1.0, scale_result = 1.0;  // scale of the best similarity original -> warped, -> optimised
   bool closed = false;
   Points original, warped, optimised;  // m x 3 each
   FeaturePlane plane;                  // the new feature plane
-  std::vector<FixedSample> fixed;      // the two samples chosen by the heuristic
-  std::vector<FixedSample> crossings;  // samples fixed where an earlier curve put the crossing
+  std::vector<FixedSample> fixed;      // in order: the two samples chosen by the heuristic; joint: the one held
+  std::vector<FixedSample> crossings;  // samples on an earlier curve (in order: fixed where it put them; joint: shared)
+  std::vector<FixedSample> cleared;    // joint: samples held at the clearance from body B (distance: how far they moved)
   double energy_warped = 0.0, energy_result = 0.0;  // eq. 9 (weights as applied) at the projected warped samples and at the result
   double shape_error_warped = 0.0, shape_error_result = 0.0;  // see curve_metrics.hpp
   double turning_angle_change_warped_deg = 0.0, turning_angle_change_result_deg = 0.0;
@@ -109,12 +143,51 @@ struct FeatureResult {
 /// Distance from a point to body B; called in parallel, so it must be thread-safe.
 using DistanceToBody = std::function<double(const Vec3&)>;
 
-/// Optimises every curve of `model` in order (eqs. 5-9), given the warped
-/// samples and warped auxiliary points of each curve (rows matching the
-/// model's). Throws refit::Error when the counts do not match or a warped point
-/// is not finite.
+/// What a point needs to clear body B by a clearance: the unit direction away
+/// from the body and how far it must still move along it (<= 0: clear).
+struct ClearanceNeed {
+  Vec3 direction = Vec3::Zero();
+  double amount = 0.0;
+};
+/// ClearanceNeed of a point for a given clearance; thread-safe.
+using ClearanceToBody = std::function<ClearanceNeed(const Vec3&, double clearance)>;
+
+/// Optimises every curve of `model` (eqs. 5-9), jointly or in order as the
+/// model's options say, given the warped samples and warped auxiliary points of
+/// each curve (rows matching the model's). `clearance_to_body_b` (joint solve,
+/// with options.clearance > 0) keeps the samples clear of body B. Throws
+/// refit::Error when the counts do not match or a warped point is not finite.
 FeatureResult match_shapes(const ShapeModel& model, const std::vector<Points>& warped_samples,
-                           const std::vector<Points>& warped_aux, const DistanceToBody& distance_to_body_b);
+                           const std::vector<Points>& warped_aux, const DistanceToBody& distance_to_body_b,
+                           const ClearanceToBody& clearance_to_body_b = {});
+
+/// The paper's rule: one curve after the other, in the model's order.
+FeatureResult match_shapes_in_order(const ShapeModel& model, const std::vector<Points>& warped_samples,
+                                    const std::vector<Points>& warped_aux, const DistanceToBody& distance_to_body_b);
+
+/// All curves in one solve (joint_matching.cpp).
+FeatureResult match_shapes_jointly(const ShapeModel& model, const std::vector<Points>& warped_samples,
+                                   const std::vector<Points>& warped_aux, const DistanceToBody& distance_to_body_b,
+                                   const ClearanceToBody& clearance_to_body_b);
+
+/// Puts every crossing sample of `result` back on the curve it meets, where
+/// the joint solve defines it (after a change of the optimised samples, such as
+/// symmetrisation, that moved the two curves differently). Joint models only.
+void restore_meetings(const ShapeModel& model, FeatureResult& result);
+
+/// The new feature plane of a curve: PCA of the warped samples and warped
+/// auxiliary points; its normal's sign and in-plane axes follow the best
+/// rotation original -> warped (Kabsch), so the 2D frame keeps its handedness
+/// and the curve is not mirrored.
+FeaturePlane warped_feature_plane(const FeatureCurve& c, const Points& warped_samples, const Points& warped_aux);
+
+/// Eq. 9 (weights as applied) at 2D coordinates x, with closeness to xw.
+double shape_energy(const CurveShape& s, const Eigen::Matrix<double, Eigen::Dynamic, 2>& x,
+                    const Eigen::Matrix<double, Eigen::Dynamic, 2>& xw, const ShapeMatchingOptions& o);
+
+/// Nearest point of a polyline to q, given a k-d tree over its vertices: the
+/// edges around the nearest vertex (exact for densely sampled curves).
+PolylinePoint nearest_near_vertex(const PointTree& tree, const Points& poly, bool closed, const Vec3& q);
 
 /// Bind once: the shape model plus the warp bindings of samples and auxiliary points on body A.
 struct FeatureBinding {
@@ -129,6 +202,6 @@ FeatureBinding bind_features(const ReferenceBody& a, std::vector<FeatureCurve> c
 /// Apply many: warps samples and auxiliary points with body B's frames and
 /// optimises every curve (match_shapes).
 FeatureResult optimise_features(const FeatureBinding& binding, const TriangleFrames& b_frames,
-                                const DistanceToBody& distance_to_body_b);
+                                const DistanceToBody& distance_to_body_b, const ClearanceToBody& clearance_to_body_b = {});
 
 }  // namespace refit

@@ -93,7 +93,11 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
     const std::size_t given = curves.size();
     if (sym.symmetric) curves = add_mirrored_curves(std::move(curves), sym.plane_x);
     for (std::size_t i = given; i < curves.size(); ++i) symmetry_report_["mirrored_features"].push_back(curves[i].name);
-    features_ = bind_features(body_a_, std::move(curves), options_.shape_matching);
+    ShapeMatchingOptions sm = options_.shape_matching;
+    // The curves end clear of body B by the collision clearance and a margin, so
+    // the collision step finds nothing to move on them (issue 13: the written garment follows the curves).
+    if (options_.collision && sm.clearance <= 0.0) sm.clearance = (options_.clearance_cm + kFeatureClearanceMarginCm) * per_cm;
+    features_ = bind_features(body_a_, std::move(curves), sm);
     if (sym.symmetric) {
       // Pairs only where the mirror image is a sample (the mirrored copies, a hem, a profile on the plane).
       double spacing = std::numeric_limits<double>::infinity();
@@ -191,6 +195,18 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
   clock.reset();
   const BodySurface surface_b(body_b);
   const auto distance_b = [&](const Vec3& p) { return surface_b.closest(p).distance; };
+  // What a feature sample needs to clear body B (the collision step's rule: out along the closest-point direction).
+  const auto clearance_b = [&](const Vec3& p, double clearance) {
+    ClearanceNeed need;
+    const bool in = surface_b.inside(p);
+    const ClosestPoint cp = in ? surface_b.closest(p) : surface_b.closest_within(p, clearance);
+    if (!in && !(cp.distance < clearance)) return need;
+    const Vec3 towards = cp.point - p;
+    const double len = towards.norm();
+    need.direction = len > 1e-12 * (1.0 + p.norm()) ? Vec3((in ? towards : -towards) / len) : cp.normal;
+    need.amount = in ? len + clearance : clearance - len;
+    return need;
+  };
 
   // Step 2: feature curves keep their shape (section 4).
   // Symmetrise only when body B is symmetric too (the same vertices as body A's, mirrored).
@@ -213,8 +229,12 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
   FeatureResult& curves = result.features;
   if (features_) {
     progress.stage("optimising " + std::to_string(features_->model.curves.size()) + " feature curves");
-    curves = optimise_features(*features_, frames_b, distance_b);
-    if (symmetric_b && !feature_mirror_.empty()) symmetrise_curves(curves, feature_mirror_, mirror_x_);
+    if (features_->model.options.clearance > 0.0) surface_b.prepare_inside_test();
+    curves = optimise_features(*features_, frames_b, distance_b, clearance_b);
+    if (symmetric_b && !feature_mirror_.empty()) {
+      symmetrise_curves(curves, feature_mirror_, mirror_x_);
+      restore_meetings(features_->model, curves);
+    }
     timings["features"] = clock.ms();
     report["features"] = features_report(curves);
   }
@@ -259,16 +279,17 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
     co.near_band *= per_cm;  // the defaults are in cm
     co.max_lift *= per_cm;
     co.face_clearance *= per_cm;
+    // The corners of the faces the curves sit on stay where the surface step put them (unless too close themselves).
+    std::vector<std::uint8_t> pinned;
+    if (!curves.curves.empty()) {
+      pinned = feature_corners(feature_attachment_, result.positions.rows());
+      co.pinned = &pinned;
+    }
     if (!near_body_a_.empty()) {
       DistanceHoldOptions ho;
       ho.tolerance *= per_cm;  // the defaults are in cm
       ho.reach *= per_cm;
-      // The corners of the faces the curves sit on stay where the surface step put them.
-      std::vector<std::uint8_t> pinned;
-      if (!curves.curves.empty()) {
-        pinned = feature_corners(feature_attachment_, result.positions.rows());
-        ho.pinned = &pinned;
-      }
+      if (!pinned.empty()) ho.pinned = &pinned;
       report["distance_hold"] = hold_body_distance(*garment_, result.positions, surface_b, near_body_a_, ho).to_json();
       // Where the body's closest point is not unique (a vertex on the spine's
       // groove) the hold's direction picks one side.

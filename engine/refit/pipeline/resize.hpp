@@ -93,4 +93,8 @@ nlohmann::json garment_summary(const Garment& g);
 
 inline constexpr const char* kVersion = "0.1.0";
 
+/// With the collision step on, the joint feature solve keeps the curves this much
+/// farther from body B than the collision clearance (ShapeMatchingOptions::clearance 0).
+inline constexpr double kFeatureClearanceMarginCm = 0.05;
+
 }  // namespace refit

@@ -69,8 +69,11 @@ void report_written_features(const FeatureResult& curves, const Points& on_resul
     // The same measure on the warped garment: on a coarse mesh, carrying samples
     // on its faces adds faceting that the free-point warp of the samples has not.
     list[i]["shape_error_output_warped"] = shape_error(on_warp.middleRows(first, m), c.original, c.closed);
-    const double curve_gap = (on_result.middleRows(first, m) - c.optimised).rowwise().norm().maxCoeff();
+    Eigen::Index worst = 0;
+    const double curve_gap = (on_result.middleRows(first, m) - c.optimised).rowwise().norm().maxCoeff(&worst);
     list[i]["gap_output"] = curve_gap;
+    list[i]["gap_output_sample"] = worst;
+    list[i]["gap_output_before_collision"] = (before_collision.middleRows(first, m) - c.optimised).rowwise().norm().maxCoeff();
     gap = std::max(gap, curve_gap);
     first += m;
   }
@@ -84,11 +87,16 @@ nlohmann::json features_report(const FeatureResult& curves) {
     for (const FixedSample& f : c.fixed) fixed.push_back({{"index", f.index}, {"reason", f.reason}, {"distance", f.distance}});
     nlohmann::json crossings = nlohmann::json::array();
     for (const FixedSample& f : c.crossings) crossings.push_back({{"index", f.index}, {"distance", f.distance}});
+    nlohmann::json cleared = nlohmann::json::array();
+    for (const FixedSample& f : c.cleared) cleared.push_back({{"index", f.index}, {"moved", f.distance}});
     list.push_back({{"name", c.name},
                     {"samples", c.original.rows()},
                     {"closed", c.closed},
                     {"fixed", fixed},
                     {"crossings", crossings},
+                    {"cleared", cleared},
+                    {"scale_warped", c.scale_warped},
+                    {"scale_result", c.scale_result},
                     {"shape_error_warped", c.shape_error_warped},
                     {"shape_error_result", c.shape_error_result},
                     {"turning_angle_change_warped_deg", c.turning_angle_change_warped_deg},

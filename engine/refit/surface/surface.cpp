@@ -190,13 +190,10 @@ SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
   clock.reset();
   std::vector<std::uint8_t> kept_vertex;
   res.positions = emit_vertices(sol, original_vertices_, warped, blends_, carries_feature_, distance, kept_vertex, st);
-  if (snaps()) {
-    const FeatureSnapReport snap = snap_to_features(res.positions, targets, feature_attachment_, blends_.reach,
-                                                    blends_.weight, feature_of_, kept_vertex, options_.snap_regularisation);
-    st.feature_gap_before_snap = snap.gap_before;
-    st.feature_gap = snap.gap_after;
-    st.vertices_snapped = snap.vertices_moved;
-  }
+  const FeatureSnapReport snapped = snap(res.positions, targets, kept_vertex);
+  st.feature_gap_before_snap = snapped.gap_before;
+  st.feature_gap = snapped.gap_after;
+  st.vertices_snapped = snapped.vertices_moved;
   res.agents = std::move(sol.x);
   st.ms.reconstruct = clock.ms();
   return res;
@@ -335,6 +332,29 @@ SurfaceBinding::AgentSolution SurfaceBinding::solve_agents(Points before_in, con
   sol.body_distance = std::move(body_distance);
   sol.x = std::move(x);
   return sol;
+}
+
+FeatureSnapReport SurfaceBinding::snap(Points& positions, const Points& targets, const std::vector<std::uint8_t>& held,
+                                       int passes) const {
+  FeatureSnapReport total;
+  if (!snaps()) return total;
+  if (static_cast<std::size_t>(targets.rows()) != feature_count() || static_cast<std::size_t>(positions.rows()) != vertex_count_)
+    throw Error("surface: the snap's targets or positions do not match the binding");
+  // (The chunked pipeline does the same passes: chunked_resize.cpp.)
+  for (int pass = 0; pass < std::max(1, passes > 0 ? passes : options_.snap_passes); ++pass) {
+    const Points before = positions;
+    const FeatureSnapReport r = snap_to_features(positions, targets, feature_attachment_, blends_.reach,
+                                                 blends_.weight, feature_of_, held, options_.snap_regularisation);
+    if (pass == 0) total = r;  // every pass moves the same vertices
+    total.gap_after = r.gap_after;
+    if (!(r.gap_after < r.gap_before)) {  // a pass that does not help is undone
+      positions = before;
+      total.gap_after = r.gap_before;
+      if (pass == 0) total.vertices_moved = 0;
+      break;
+    }
+  }
+  return total;
 }
 
 }  // namespace refit

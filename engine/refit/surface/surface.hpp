@@ -15,6 +15,7 @@
 #include <refit/surface/agent_system.hpp>
 #include <refit/surface/agents.hpp>
 #include <refit/surface/coarse_levels.hpp>
+#include <refit/surface/feature_snap.hpp>
 
 #include <functional>
 #include <memory>
@@ -49,6 +50,8 @@ struct SurfaceOptions {
   bool snap_to_features = true;    // with a feature zone: correct the vertices near the features so that the written
                                    // garment passes through the optimised curves (see feature_snap.hpp)
   double snap_regularisation = 1e-3;  // Tikhonov weight of that correction, relative to its normal equations' diagonal
+  int snap_passes = 4;             // the correction repeated on what is left (each pass removes most of the rest where
+                                   // the samples do not conflict; the regularisation keeps one pass from overshooting)
   bool keep_clear_of_body = true;  // free agents the solve leaves closer than `clearance` to body B (or inside) are held
                                    // at that clearance and the system is solved again (see apply; false: the paper)
   double clearance = 0.4;          // garment units (the pipeline passes twice its collision clearance, so vertices
@@ -269,6 +272,13 @@ class SurfaceBinding {
   /// The same with body B's Embree closest-point query.
   SurfaceResult apply(const Points& warped_vertices, const Points& feature_targets, const BodySurface& body_b,
                       const Points* feature_warped = nullptr, SurfaceSystem* system = nullptr) const;
+
+  /// The last step of apply on its own: moves `positions` (every vertex) so the
+  /// feature samples reach `feature_targets` (feature_snap.hpp), leaving `held`
+  /// vertices (those apply keeps at their warped positions) alone. Zero report
+  /// without a zone. `passes`: at most this many corrections (0: SurfaceOptions::snap_passes).
+  FeatureSnapReport snap(Points& positions, const Points& feature_targets, const std::vector<std::uint8_t>& held,
+                         int passes = 0) const;
 
   /// Eq. 13 on the fine agents (rows() encoding) with right-hand side h, from x
   /// (updated in place; agents with free[a] == 0 keep their x), by `solver` with
