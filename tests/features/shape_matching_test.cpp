@@ -69,7 +69,9 @@ TEST(ShapeMatching, SimilarityCopyIsLeftUnchanged) {
     EXPECT_NEAR(cr.scale_result, scale, 1e-9);
     ASSERT_EQ(cr.fixed.size(), joint ? 1u : 2u);
     EXPECT_EQ(cr.fixed[0].reason, "body");
-    if (!joint) EXPECT_NE(cr.fixed[0].index, cr.fixed[1].index);
+    if (!joint) {
+      EXPECT_NE(cr.fixed[0].index, cr.fixed[1].index);
+    }
     // The new plane is the transformed old one, not mirrored.
     EXPECT_NEAR(cr.plane.normal.dot(R * Vec3::UnitZ()), 1.0, 1e-9);
   }
