@@ -181,14 +181,10 @@ void resize_to_targets(const RealGarment& rg, const std::vector<std::string>& ta
     EXPECT_EQ(centres_result, 0u);
     double sum_output_warped = 0.0, sum_output = 0.0;
     for (const auto& f : r.report.at("features")) {
-      // What the surface step leaves, before the collision step moves anything
-      // (until this session's report change this was the report's
-      // shape_error_output; the written garment's figure is printed beside it:
-      // where the surface step leaves a profile inside body B, the collision step
-      // moves it out and the written profile is only 1.0x-1.2x the warp's on the
-      // thinner body: issue 13, not met).
+      // `output`: the written garment (after the collision step: issue 13);
+      // `before`: what the surface step leaves, before the collision step.
       const double warped = f.at("shape_error_warped"), curve = f.at("shape_error_result");
-      const double output = f.at("shape_error_output_before_collision"), written = f.at("shape_error_output");
+      const double before = f.at("shape_error_output_before_collision"), output = f.at("shape_error_output");
       const double output_warped = f.at("shape_error_output_warped");
       ASSERT_TRUE(std::isfinite(output));
       sum_output_warped += output_warped;
@@ -197,14 +193,24 @@ void resize_to_targets(const RealGarment& rg, const std::vector<std::string>& ta
       // alone leaves it (1e-4: the skirt's hem is already at 0.0002 after the warp).
       EXPECT_LT(output, output_warped + 1e-4) << f.at("name");
       const std::string name = f.at("name");
-      if (name == "left" || name == "right") {
-        EXPECT_GT(output_warped, side_gain * output) << name;
+      if (side_gain > 0.0 && (name == "left" || name == "right")) {
+        // The feature zone: the surface step follows the optimised side profiles
+        // (side_gain better than the warp), or, where the body forbids the shape
+        // (the curve itself had to be moved clear of body B and is less than
+        // side_gain better than the warp: the dress's side profiles on F_thinner,
+        // 2x), keeps what the curve has. The written garment's figure is printed:
+        // the collision step moves some of it (issue 13's 10x, see below).
+        if (!f.at("cleared").empty() && warped < side_gain * curve) {
+          EXPECT_LT(before, 1.25 * curve) << name;
+        } else {
+          EXPECT_GT(output_warped, side_gain * before) << name;
+        }
       }
       std::printf("[ info ]   %-6s shape error: warp %.5f, optimised curve %.5f (%.0fx), surface step %.5f (%.1fx); "
                   "carried on the warped garment %.5f (%.1fx); written garment %.5f (%.1fx)\n",
-                  f.at("name").get<std::string>().c_str(), warped, curve, warped / std::max(curve, 1e-12), output,
-                  warped / std::max(output, 1e-12), output_warped, output_warped / std::max(output, 1e-12), written,
-                  output_warped / std::max(written, 1e-12));
+                  f.at("name").get<std::string>().c_str(), warped, curve, warped / std::max(curve, 1e-12), before,
+                  warped / std::max(before, 1e-12), output_warped, output_warped / std::max(before, 1e-12), output,
+                  output_warped / std::max(output, 1e-12));
     }
     // Over all five features the written garment keeps the curves' shape clearly
     // better than the warp alone, measured alike (samples carried on the garment's
@@ -244,10 +250,14 @@ const std::vector<std::string> kTargets = {"F_heavier", "F_thinner", "F_taller"}
 // The default feature zone (one one-ring step): near a feature the feature wins
 // over eq. 14 and the written garment is snapped through the optimised curves.
 // The side profiles of these tight garments (1-2 cm from the body) keep their
-// shape (written garment against the warp, both carried on the garment's faces):
-// measured 10.4x-25.5x on the dress and 36x-82x on the skirt; the outfit's dress
-// over the jeans 10.4x and 16.8x (7.9x and 15.4x before the layers had agents
-// of their own: the dress's vertices blended the jeans' agents).
+// shape (against the warp, both carried on the garment's faces). Surface step:
+// 17.8x-43.9x on the dress on F_heavier and F_taller, 2.1x on F_thinner (the
+// optimised curve itself 2x: keeping its shape it would end 1 cm inside the
+// thinner waist, docs/method.md), 30x-68x on the skirt, the outfit's dress over
+// the jeans 13.7x-14.2x. Written garment (issue 13 asks 10x): dress 16.4x-41.7x,
+// 1.6x on F_thinner (main before the joint solve: 7.8x-8.4x and 1.4x); skirt
+// 10.3x-64.8x; outfit 6.2x and 11.3x (before: 4.3x and 5.8x): there the
+// collision step moves the corners of the faces the left profile sits on.
 TEST(PipelineSharedData, DressToEveryTarget) {
   resize_to_targets({"dress_on_A_female.obj", 5.0, -29.9, -11.5, true}, kTargets, 1, 10.0);
 }

@@ -47,8 +47,13 @@ TEST(SymmetrySharedData, OneSidedProfileKeepsSkirtSymmetric) {
     EXPECT_TRUE(sym.at("symmetric").get<bool>()) << target;
     EXPECT_EQ(sym.at("mirrored_features"), nlohmann::json::array({"left~mirror"})) << target;
     const double warp = mirror_error(garment->positions, r.warped), result = mirror_error(garment->positions, r.positions);
-    std::printf("[ info ] skirt -> %s: mirror error %.3f cm (warp %.3f cm), feature gap %.4f cm\n", target, result, warp,
-                r.report.at("surface").at("feature_gap").get<double>());
+    // The surface step goes through the symmetrised curves (the gap asserted).
+    // On the written garment the gap is 0.18-0.26 cm (issue 13's 0.05 not met):
+    // the collision step moves the waistband faces' corners under the front
+    // profile's top samples (docs/method.md).
+    std::printf("[ info ] skirt -> %s: mirror error %.3f cm (warp %.3f cm), feature gap %.4f cm (written %.4f cm)\n",
+                target, result, warp, r.report.at("surface").at("feature_gap").get<double>(),
+                r.report.at("surface").at("feature_gap_written").get<double>());
     EXPECT_LE(result, warp + 0.1) << target;
     EXPECT_LE(r.report.at("surface").at("feature_gap").get<double>(), 0.05) << target;
     EXPECT_TRUE(sym.at("symmetrised").get<bool>()) << target;
