@@ -49,8 +49,10 @@ SurfaceAttachment chunked_attach(const GarmentStore& g, const PointGather& x, co
   };
   const std::pair<const CsrFile*, Csr Garment::*> kinds[] = {
       {&g.faces(), &Garment::faces}, {&g.lines(), &Garment::lines}, {&g.points(), &Garment::points}};
-  for (const auto& [file, kind] : kinds)
-    for_each_chunk(*file, plan.chunk_faces, [&](std::size_t, const Csr& rows) { take(block_garment(rows, x, kind, ids)); });
+  for (const auto& entry : kinds) {  // not a structured binding: clang 14 cannot capture one (fuzz preset)
+    Csr Garment::*const kind = entry.second;
+    for_each_chunk(*entry.first, plan.chunk_faces, [&](std::size_t, const Csr& rows) { take(block_garment(rows, x, kind, ids)); });
+  }
   if (g.face_count() + g.line_count() + g.point_count() == 0) {
     // A garment without elements attaches to its vertices (GarmentLocator does so).
     for (std::size_t first = 0; first < g.vertex_count(); first += plan.chunk_vertices) {

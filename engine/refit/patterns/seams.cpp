@@ -39,7 +39,8 @@ std::vector<Seam> chain_seams(const PanelSet& set, std::span<const SeamCorners> 
   }
 
   std::vector<Seam> seams;
-  for (auto& [key, edges] : groups) {
+  for (auto& group : groups) {
+    auto& edges = group.second;  // not a structured binding: clang 14 cannot capture one (fuzz preset)
     std::map<Index, std::vector<Index>> at;  // garment vertex -> its cut edges
     for (Index i = 0; i < edges.size(); ++i)
       for (Index x : edges[i].x) at[x].push_back(i);
