@@ -484,18 +484,23 @@ BodySurface& BodySurface::operator=(BodySurface&&) noexcept = default;
 
 ClosestPoint BodySurface::closest(const Vec3& p) const { return closest_within(p, kInf); }
 
-ClosestPoint BodySurface::closest_within(const Vec3& p, double max_distance) const {
-  const PointQueryData d = impl_->query(p, max_distance);
+namespace {
+ClosestPoint closest_of(const PointQueryData& d, const Points& face_normal) {
   ClosestPoint r;
   if (!std::isfinite(d.best_d2)) {
     r.distance = kInf;
     return r;
   }
   r.point = d.point;
-  r.normal = row3(impl_->face_normal, d.tri);
+  r.normal = row3(face_normal, d.tri);
   r.distance = std::sqrt(d.best_d2);
   r.triangle = d.tri;
   return r;
+}
+}  // namespace
+
+ClosestPoint BodySurface::closest_within(const Vec3& p, double max_distance) const {
+  return closest_of(impl_->query(p, max_distance), impl_->face_normal);
 }
 
 SignedClosestPoint BodySurface::signed_closest_within(const Vec3& p, double max_distance) const {
@@ -505,15 +510,8 @@ SignedClosestPoint BodySurface::signed_closest_within(const Vec3& p, double max_
     return r;
   }
   const PointQueryData d = impl_->query(p, max_distance);
-  if (!std::isfinite(d.best_d2)) {
-    r.distance = kInf;
-    return r;
-  }
-  r.point = d.point;
-  r.normal = row3(impl_->face_normal, d.tri);
-  r.distance = std::sqrt(d.best_d2);
-  r.triangle = d.tri;
-  r.inside = impl_->inside_given(d);
+  static_cast<ClosestPoint&>(r) = closest_of(d, impl_->face_normal);
+  if (std::isfinite(d.best_d2)) r.inside = impl_->inside_given(d);
   return r;
 }
 

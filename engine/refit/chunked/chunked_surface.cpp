@@ -9,6 +9,7 @@
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
 #include <refit/core/progress.hpp>
+#include <refit/core/union_find.hpp>
 #include <refit/core/weld.hpp>
 
 #include <tbb/parallel_sort.h>
@@ -24,11 +25,6 @@ namespace {
 using namespace sampling;
 
 constexpr std::size_t kGrain = 2048;  // select_agents' and surface_measure's grain (agents.cpp)
-
-Index find_root(std::vector<Index>& parent, Index a) {
-  while (parent[a] != a) a = parent[a] = parent[parent[a]];
-  return a;
-}
 
 double face_area(const ElementBlock& b, std::size_t f) {
   const std::size_t o = b.rows.offsets[f], k = b.rows.row_size(f);
@@ -67,16 +63,11 @@ std::vector<std::uint32_t> chunked_layers(const GarmentStore& g, const PointGath
   const std::size_t n = g.vertex_count();
   std::vector<Index> parent(n);
   std::iota(parent.begin(), parent.end(), Index{0});
-  const auto unite = [&](Index a, Index b) {
-    a = find_root(parent, a);
-    b = find_root(parent, b);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  };
   for (const CsrFile* c : {&g.faces(), &g.lines(), &g.points()})
     for_each_chunk(*c, plan.chunk_faces, [&](std::size_t, const Csr& rows) {
       for (std::size_t e = 0; e < rows.rows(); ++e) {
         auto r = rows.row(e);
-        for (std::size_t k = 1; k < r.size(); ++k) unite(r[0], r[k]);
+        for (std::size_t k = 1; k < r.size(); ++k) unite_roots(parent, r[0], r[k]);
       }
     });
   // Coincident vertices welded only when the faces are in several pieces.
@@ -93,7 +84,7 @@ std::vector<std::uint32_t> chunked_layers(const GarmentStore& g, const PointGath
     weld = chunked_weld(g, plan, 1e-6 * bounding_box_diagonal(g));
     for (Index v = 0; v < n; ++v) {  // in vertex order, as garment_layers unites
       const auto it = weld.find(v);
-      unite(v, it == weld.end() ? v : it->second);
+      unite_roots(parent, v, it == weld.end() ? v : it->second);
     }
   }
   const auto welded = [&](Index v) {
@@ -145,7 +136,7 @@ std::vector<std::uint32_t> chunked_layers(const GarmentStore& g, const PointGath
     Points bp;
     x.gather(boundary, bp);
     const std::vector<Index> near = weld_points(bp, join_distance);
-    for (std::size_t i = 0; i < boundary.size(); ++i) unite(boundary[i], boundary[near[i]]);
+    for (std::size_t i = 0; i < boundary.size(); ++i) unite_roots(parent, boundary[i], boundary[near[i]]);
     area = piece_area();
   }
   // Roots first (parents point to smaller vertices), then each vertex's label in place.

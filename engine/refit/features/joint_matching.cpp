@@ -443,12 +443,7 @@ FeatureResult match_shapes_jointly(const ShapeModel& model, const std::vector<Po
     }
     r.energy_warped = shape_energy(model.shapes[k], xw, xw, o);
     r.energy_result = shape_energy(model.shapes[k], x, xw, o);
-    r.shape_error_warped = shape_error(r.warped, r.original, c.closed);
-    r.shape_error_result = shape_error(r.optimised, r.original, c.closed);
-    r.turning_angle_change_warped_deg = turning_angle_change_deg(r.warped, r.original, c.closed);
-    r.turning_angle_change_result_deg = turning_angle_change_deg(r.optimised, r.original, c.closed);
-    r.scale_warped = similarity_scale(r.original, r.warped);
-    r.scale_result = similarity_scale(r.original, r.optimised);
+    measure_curve_result(r, c.closed);
   }
   return result;
 }

@@ -409,15 +409,19 @@ FeatureResult match_shapes_in_order(const ShapeModel& model, const std::vector<P
     for (std::size_t i = 0; i < m; ++i)
       r.optimised.row(static_cast<Eigen::Index>(i)) = r.plane.to_3d(x.row(static_cast<Eigen::Index>(i)).transpose()).transpose();
     for (const auto& [i, p] : exact) r.optimised.row(i) = p.transpose();
-    r.shape_error_warped = shape_error(r.warped, r.original, c.closed);
-    r.shape_error_result = shape_error(r.optimised, r.original, c.closed);
-    r.turning_angle_change_warped_deg = turning_angle_change_deg(r.warped, r.original, c.closed);
-    r.turning_angle_change_result_deg = turning_angle_change_deg(r.optimised, r.original, c.closed);
-    r.scale_warped = similarity_scale(r.original, r.warped);
-    r.scale_result = similarity_scale(r.original, r.optimised);
+    measure_curve_result(r, c.closed);
     result.curves.push_back(std::move(r));
   }
   return result;
+}
+
+void measure_curve_result(CurveResult& r, bool closed) {
+  r.shape_error_warped = shape_error(r.warped, r.original, closed);
+  r.shape_error_result = shape_error(r.optimised, r.original, closed);
+  r.turning_angle_change_warped_deg = turning_angle_change_deg(r.warped, r.original, closed);
+  r.turning_angle_change_result_deg = turning_angle_change_deg(r.optimised, r.original, closed);
+  r.scale_warped = similarity_scale(r.original, r.warped);
+  r.scale_result = similarity_scale(r.original, r.optimised);
 }
 
 FeatureBinding bind_features(const ReferenceBody& a, std::vector<FeatureCurve> curves, const ShapeMatchingOptions& options) {

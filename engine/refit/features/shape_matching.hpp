@@ -136,6 +136,10 @@ struct CurveResult {
   double turning_angle_change_warped_deg = 0.0, turning_angle_change_result_deg = 0.0;
 };
 
+/// Fills r's shape errors, turning-angle changes and similarity scales, warped
+/// and optimised against the original (curve_metrics.hpp).
+void measure_curve_result(CurveResult& r, bool closed);
+
 struct FeatureResult {
   std::vector<CurveResult> curves;
 };

@@ -2,6 +2,7 @@
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
 #include <refit/core/spatial_order.hpp>
+#include <refit/core/union_find.hpp>
 #include <refit/core/weld.hpp>
 #include <refit/surface/agents.hpp>
 #include <refit/surface/samples.hpp>
@@ -33,10 +34,6 @@ void check_garment(const Garment& g) {
       if (v >= n) throw Error("surface: garment element refers to vertex " + std::to_string(v + 1) + " of " + std::to_string(n));
 }
 
-Index find_root(std::vector<Index>& parent, Index a) {
-  while (parent[a] != a) a = parent[a] = parent[parent[a]];
-  return a;
-}
 }  // namespace
 
 void check_finite(const Points& points, const std::string& what) {
@@ -149,15 +146,10 @@ std::vector<std::uint32_t> garment_layers(const Garment& g, double min_area, dou
   const Points& x = g.positions;
   std::vector<Index> parent(n);
   std::iota(parent.begin(), parent.end(), Index{0});
-  const auto unite = [&](Index a, Index b) {
-    a = find_root(parent, a);
-    b = find_root(parent, b);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  };
   for (const Csr* c : {&g.faces, &g.lines, &g.points})
     for (std::size_t e = 0; e < c->rows(); ++e) {
       auto r = c->row(e);
-      for (std::size_t k = 1; k < r.size(); ++k) unite(r[0], r[k]);
+      for (std::size_t k = 1; k < r.size(); ++k) unite_roots(parent, r[0], r[k]);
     }
   // Coincident vertices welded only when the faces are in several pieces (most
   // garments are one: welding a million vertices costs about 50 ms).
@@ -168,7 +160,7 @@ std::vector<std::uint32_t> garment_layers(const Garment& g, double min_area, dou
   std::iota(weld.begin(), weld.end(), Index{0});
   if (several) {
     weld = weld_points(x, 1e-6 * bounding_box_diagonal(x));
-    for (std::size_t v = 0; v < n; ++v) unite(Index(v), weld[v]);
+    for (std::size_t v = 0; v < n; ++v) unite_roots(parent, Index(v), weld[v]);
   }
   std::vector<double> face_area(g.faces.rows(), 0.0);
   parallel_for(0, g.faces.rows(), kGrain, [&](std::size_t b, std::size_t e) {
@@ -210,7 +202,7 @@ std::vector<std::uint32_t> garment_layers(const Garment& g, double min_area, dou
     Points bp(static_cast<Eigen::Index>(boundary.size()), 3);
     for (std::size_t i = 0; i < boundary.size(); ++i) bp.row(Eigen::Index(i)) = x.row(boundary[i]);
     const std::vector<Index> near = weld_points(bp, join_distance);
-    for (std::size_t i = 0; i < boundary.size(); ++i) unite(boundary[i], boundary[near[i]]);
+    for (std::size_t i = 0; i < boundary.size(); ++i) unite_roots(parent, boundary[i], boundary[near[i]]);
     area = piece_area();
   }
   std::vector<std::uint32_t> label(n, 0), of_root(n, 0);
