@@ -289,36 +289,47 @@ struct BodySurface::Impl {
     // thread count. Isolated: this runs inside call_once, often from a parallel
     // loop; a thread waiting here must not pick up that loop's tasks (they would
     // enter call_once again and deadlock).
+    // A scanline fill: runs of free cells along x, so the walk reads whole rows
+    // (a cell-by-cell fill touched the z neighbours a plane apart for every cell:
+    // about a sixth of a small garment's resize went to it). The same regions and
+    // the same vote cell (the first free cell in index order) as a cell-by-cell fill.
     constexpr long kSlabs = 16;
     const long plane = grid_n[0] * grid_n[1];
-    auto fill_slab = [&](long slab, std::vector<long>& queue) {
+    const long nx = grid_n[0];
+    auto free_at = [&](long i) { return grid[static_cast<std::size_t>(i)] == 255; };
+    auto fill_slab = [&](long slab, std::vector<long>& seeds) {
       const long z0 = grid_n[2] * slab / kSlabs, z1 = grid_n[2] * (slab + 1) / kSlabs;
       for (long start = z0 * plane; start < z1 * plane; ++start) {
-        if (grid[static_cast<std::size_t>(start)] != 255) continue;
-        const long sx = start % grid_n[0], sy = (start / grid_n[0]) % grid_n[1], sz = start / plane;
+        if (!free_at(start)) continue;
+        const long sx = start % nx, sy = (start / nx) % grid_n[1], sz = start / plane;
         const Vec3 centre = grid_lo + grid_h * Vec3(sx + 0.5, sy + 0.5, sz + 0.5);
         const std::uint8_t label = inside_by_rays(centre) ? kInside : kOutside;
-        queue.assign(1, start);
-        grid[static_cast<std::size_t>(start)] = label;
-        while (!queue.empty()) {
-          const long c = queue.back();
-          queue.pop_back();
-          const long x = c % grid_n[0], y = (c / grid_n[0]) % grid_n[1], z = c / plane;
-          const long nb[6][3] = {{x - 1, y, z}, {x + 1, y, z}, {x, y - 1, z}, {x, y + 1, z}, {x, y, z - 1}, {x, y, z + 1}};
-          for (const auto& q : nb) {
-            if (q[0] < 0 || q[1] < 0 || q[2] < z0 || q[0] >= grid_n[0] || q[1] >= grid_n[1] || q[2] >= z1) continue;
-            const long qi = cell_index(q[0], q[1], q[2]);
-            if (grid[static_cast<std::size_t>(qi)] != 255) continue;
-            grid[static_cast<std::size_t>(qi)] = label;
-            queue.push_back(qi);
+        seeds.assign(1, start);
+        while (!seeds.empty()) {
+          const long seed = seeds.back();
+          seeds.pop_back();
+          if (!free_at(seed)) continue;
+          const long row = seed - seed % nx;  // index of x = 0 in the seed's row
+          long lo_x = seed - row, hi_x = lo_x;
+          while (lo_x > 0 && free_at(row + lo_x - 1)) --lo_x;
+          while (hi_x + 1 < nx && free_at(row + hi_x + 1)) ++hi_x;
+          std::fill(grid.begin() + row + lo_x, grid.begin() + row + hi_x + 1, label);
+          // One seed per run of free cells in the four neighbouring rows, over the span.
+          const long y = (row / nx) % grid_n[1], z = row / plane;
+          const long neighbours[4][2] = {{y - 1, z}, {y + 1, z}, {y, z - 1}, {y, z + 1}};
+          for (const auto& q : neighbours) {
+            if (q[0] < 0 || q[0] >= grid_n[1] || q[1] < z0 || q[1] >= z1) continue;
+            const long other = (q[1] * grid_n[1] + q[0]) * nx;
+            for (long x = lo_x; x <= hi_x; ++x)
+              if (free_at(other + x) && (x == lo_x || !free_at(other + x - 1))) seeds.push_back(other + x);
           }
         }
       }
     };
     tbb::this_task_arena::isolate([&] {
       parallel_for(0, kSlabs, 1, [&](std::size_t b, std::size_t e) {
-        std::vector<long> queue;
-        for (std::size_t slab = b; slab < e; ++slab) fill_slab(long(slab), queue);
+        std::vector<long> seeds;
+        for (std::size_t slab = b; slab < e; ++slab) fill_slab(long(slab), seeds);
       });
     });
   }
