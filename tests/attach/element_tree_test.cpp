@@ -179,6 +179,34 @@ TEST(ElementTree, FindsWhatAScanFindsOnFineTubes) {
   expect_tree_finds_the_scans(elements, x, queries);
 }
 
+TEST(ElementTree, FindsWhatAScanFindsWhenBuiltInParallel) {
+  // Over 2^16 elements the top levels of the tree are built in parallel: a
+  // fine bumpy sheet of 160k triangles, queried at its vertices, mirror images
+  // and points off it (including far away) against the scan.
+  const int n = 283;
+  Points x(n * n, 3);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) x.row(j * n + i) << 0.1 * i, 0.1 * j, 0.3 * std::sin(0.05 * i) * std::cos(0.07 * j);
+  std::vector<Element> elements;
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i) {
+      const Index a = Index(j * n + i);
+      elements.push_back({{a, a + 1, a + Index(n) + 1}, 3});
+      elements.push_back({{a, a + Index(n) + 1, a + Index(n)}, 3});
+    }
+  ASSERT_GT(elements.size(), std::size_t(1) << 17);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  Points queries(90, 3);
+  for (Eigen::Index q = 0; q < queries.rows(); ++q) {
+    Vec3 p = row3(x, Index(q * 797 % x.rows()));
+    if (q % 3 == 0) p.x() = 20.0 - p.x();
+    if (q % 3 == 1) p += Vec3(u(rng), u(rng), q % 2 ? u(rng) : 40.0 * u(rng));
+    queries.row(q) = p.transpose();
+  }
+  expect_tree_finds_the_scans(elements, x, queries);
+}
+
 TEST(ElementTree, FindsWhatAScanFindsOnTheSharedGarments) {
   const std::string data = test::shared_data_dir();
   if (data.empty()) GTEST_SKIP() << "the shared data (../shared/data) is absent";

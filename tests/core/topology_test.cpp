@@ -164,6 +164,23 @@ TEST(Topology, DegenerateFaceWithRepeatedVertexIsKept) {
   EXPECT_EQ(boundary_loops(g)[0], (std::vector<Index>{0, 1, 2}));
 }
 
+TEST(Topology, BoundaryVerticesOfWeldedSoupAreTheOuterRing) {
+  // Two triangles of a square, as a soup (six vertices): apart, all six
+  // vertices are on the boundary; welded (3 -> 0, 4 -> 2), the shared diagonal
+  // 0-2 is used twice and the outer ring 0, 1, 2, 5 is left.
+  const Garment g = make(6, {{0, 1, 2}, {3, 4, 5}});
+  std::vector<Index> apart = {0, 1, 2, 3, 4, 5};
+  EXPECT_EQ(boundary_vertices(g, apart), apart);
+  const std::vector<Index> welded = {0, 1, 2, 0, 2, 5};
+  EXPECT_EQ(boundary_vertices(g, welded), (std::vector<Index>{0, 1, 2, 5}));
+  // A triangle welded onto one edge: its side 0-0 is no edge, 0-2 is used twice.
+  EXPECT_TRUE(boundary_vertices(make(3, {{0, 1, 2}}), {0, 0, 2}).empty());
+  // A closed cube has no boundary.
+  const Garment cube = make(8, {{0, 1, 2, 3}, {4, 7, 6, 5}, {0, 4, 5, 1}, {1, 5, 6, 2}, {2, 6, 7, 3}, {3, 7, 4, 0}});
+  EXPECT_TRUE(boundary_vertices(cube, {0, 1, 2, 3, 4, 5, 6, 7}).empty());
+  EXPECT_THROW(boundary_vertices(g, {0, 1}), Error);
+}
+
 TEST(Topology, IndexOutOfRangeThrows) {
   const Garment g = make(3, {{0, 1, 7}});
   EXPECT_THROW(topology_stats(g), Error);

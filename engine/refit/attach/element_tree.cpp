@@ -143,10 +143,11 @@ ElementTree::ElementTree(const std::vector<Element>& elements, const Points& x) 
     }
   });
   nodes_.reserve(n / kLeaf / 2 + 1);
-  root_ = build(curve.key, 0, n, root_box_);
+  root_ = build(curve.key, 0, n, root_box_, nodes_, 2);
 }
 
-ElementTree::Ref ElementTree::build(const std::vector<std::uint64_t>& key, std::size_t b, std::size_t e, Box& box) {
+ElementTree::Ref ElementTree::build(const std::vector<std::uint64_t>& key, std::size_t b, std::size_t e, Box& box,
+                                    std::vector<Node>& nodes, int parallel_levels) const {
   if (e - b <= kLeaf) {
     box = box_of(elements_[b]);
     for (std::size_t k = b + 1; k < e; ++k) box.grow(box_of(elements_[k]));
@@ -173,24 +174,42 @@ ElementTree::Ref ElementTree::build(const std::vector<std::uint64_t>& key, std::
       part[parts++] = {m, hi};
     }
   }
-  const auto index = static_cast<std::uint32_t>(nodes_.size());
-  nodes_.emplace_back();
+  const auto index = static_cast<std::uint32_t>(nodes.size());
+  nodes.emplace_back();
   Node node;
   for (int s = 0; s < 4; ++s) {
     for (int k = 0; k < 3; ++k) node.lo[k][s] = kFloatInf, node.hi[k][s] = -kFloatInf;
     node.child[s] = 0;
     node.count[s] = 0xff;
   }
-  for (std::size_t s = 0; s < parts; ++s) {
-    Box child_box;
-    const Ref r = build(key, part[s].first, part[s].second, child_box);
-    for (int k = 0; k < 3; ++k) node.lo[k][s] = child_box.lo[k], node.hi[k][s] = child_box.hi[k];
-    node.child[s] = r.index;
-    node.count[s] = r.count;
-    if (s == 0) box = child_box;
-    else box.grow(child_box);
+  std::array<Box, 4> child_box;
+  std::array<Ref, 4> ref;
+  if (parallel_levels > 0 && e - b >= (std::size_t(1) << 16)) {
+    std::array<std::vector<Node>, 4> sub;
+    parallel_for(0, parts, 1, [&](std::size_t sb, std::size_t se) {
+      for (std::size_t s = sb; s < se; ++s)
+        ref[s] = build(key, part[s].first, part[s].second, child_box[s], sub[s], parallel_levels - 1);
+    });
+    for (std::size_t s = 0; s < parts; ++s) {  // renumbered as if built here, depth first
+      const auto offset = static_cast<std::uint32_t>(nodes.size());
+      for (Node& m : sub[s])
+        for (int k = 0; k < 4; ++k)
+          if (m.count[k] == 0) m.child[k] += offset;
+      if (ref[s].count == 0) ref[s].index += offset;
+      nodes.insert(nodes.end(), sub[s].begin(), sub[s].end());
+    }
+  } else {
+    for (std::size_t s = 0; s < parts; ++s)
+      ref[s] = build(key, part[s].first, part[s].second, child_box[s], nodes, 0);
   }
-  nodes_[index] = node;
+  for (std::size_t s = 0; s < parts; ++s) {
+    for (int k = 0; k < 3; ++k) node.lo[k][s] = child_box[s].lo[k], node.hi[k][s] = child_box[s].hi[k];
+    node.child[s] = ref[s].index;
+    node.count[s] = ref[s].count;
+    if (s == 0) box = child_box[s];
+    else box.grow(child_box[s]);
+  }
+  nodes[index] = node;
   return {index, 0};
 }
 

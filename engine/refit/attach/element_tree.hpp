@@ -71,8 +71,12 @@ class ElementTree {
   Box box_of(const Element& e) const;
   Disc disc_of(const Element& e) const;
   static float distance2(const Disc& d, const std::array<float, 3>& q, float scale);
-  // The subtree over sorted elements [b, e); writes its box.
-  Ref build(const std::vector<std::uint64_t>& key, std::size_t b, std::size_t e, Box& box);
+  // The subtree over sorted elements [b, e), its nodes appended to `nodes` in
+  // depth-first order; writes its box. The children of the top `parallel_levels`
+  // levels are built at once, each into nodes of its own, then appended in
+  // order (the same nodes as one depth-first pass).
+  Ref build(const std::vector<std::uint64_t>& key, std::size_t b, std::size_t e, Box& box, std::vector<Node>& nodes,
+            int parallel_levels) const;
 
   const Points& x_;
   std::vector<Element> elements_;  // in curve order

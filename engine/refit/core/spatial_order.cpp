@@ -18,12 +18,22 @@ CurveOrder curve_order(std::size_t n, const std::function<Vec3(std::size_t)>& po
   out.order.resize(n);
   out.key.resize(n);
   if (n == 0) return out;
-  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-  for (std::size_t i = 0; i < n; ++i) {
+  // The finite coordinates' box (min and max: exact in any order of combination).
+  struct Bounds {
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    Bounds& operator+=(const Bounds& o) {
+      lo = lo.cwiseMin(o.lo), hi = hi.cwiseMax(o.hi);
+      return *this;
+    }
+  };
+  const Bounds box = deterministic_sum(0, n, 1 << 14, Bounds{}, [&](std::size_t i) {
     const Vec3 v = point(i);
+    Bounds b;
     for (int k = 0; k < 3; ++k)
-      if (std::isfinite(v[k])) lo[k] = std::min(lo[k], v[k]), hi[k] = std::max(hi[k], v[k]);
-  }
+      if (std::isfinite(v[k])) b.lo[k] = b.hi[k] = v[k];
+    return b;
+  });
+  const Vec3 lo = box.lo, hi = box.hi;
   constexpr double kCells = double((1u << 21) - 1);
   Vec3 scale;
   for (int k = 0; k < 3; ++k) scale[k] = hi[k] > lo[k] ? kCells / (hi[k] - lo[k]) : 0.0;

@@ -43,14 +43,16 @@ struct FaceEdges {
   std::vector<Index> start, hi;
 };
 
-FaceEdges face_edges(const Garment& g) {
+/// With `id`, each corner's vertex v stands for id[v] (welded vertices).
+FaceEdges face_edges(const Garment& g, const std::vector<Index>* id = nullptr) {
   const std::size_t n = g.vertex_count(), faces = g.faces.rows();
   constexpr std::size_t kGrain = 1 << 14;
   const auto each_side = [&](std::size_t begin, std::size_t end, auto&& f) {
     for (std::size_t r = begin; r < end; ++r) {
       const auto row = g.faces.row(r);
       for (std::size_t k = 0; k < row.size(); ++k) {
-        const Index a = row[k], b = row[k + 1 == row.size() ? 0 : k + 1];
+        Index a = row[k], b = row[k + 1 == row.size() ? 0 : k + 1];
+        if (id) a = (*id)[a], b = (*id)[b];
         if (a != b) f(std::min(a, b), std::max(a, b));
       }
     }
@@ -142,6 +144,20 @@ TopologyStats topology_stats(const Garment& g) {
   }
   s.boundary_loops = loops_from_edges(g, edges).size();
   return s;
+}
+
+std::vector<Index> boundary_vertices(const Garment& g, const std::vector<Index>& id) {
+  check_indices(g);
+  if (id.size() != g.vertex_count()) throw Error("internal: boundary_vertices needs one id per vertex");
+  for (Index i : id)
+    if (i >= id.size()) throw Error("internal: boundary_vertices: a vertex id out of range");
+  std::vector<Index> out;
+  for_each_edge(face_edges(g, &id), [&](Index lo, Index hi, Index k) {
+    if (k == 1) out.insert(out.end(), {lo, hi});
+  });
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
 }
 
 std::vector<std::vector<Index>> boundary_loops(const Garment& g) {

@@ -30,6 +30,11 @@ std::vector<std::vector<Index>> boundary_loops(const Garment& g);
 std::vector<std::vector<Index>> boundary_loops_of(const std::vector<std::uint64_t>& boundary,
                                                   const std::vector<std::uint8_t>& forward);
 
+/// The ends of the boundary edges (used by exactly one face side) with every
+/// vertex v read as id[v] (for example welded vertices; id[v] < vertex count),
+/// as ids, ascending, without repeats. Linear in the face corners.
+std::vector<Index> boundary_vertices(const Garment& g, const std::vector<Index>& id);
+
 /// Vertex adjacency (CSR, sorted, no duplicates) from faces and `l` lines.
 Csr vertex_adjacency(const Garment& g);
 

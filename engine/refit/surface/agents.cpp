@@ -2,6 +2,7 @@
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
 #include <refit/core/spatial_order.hpp>
+#include <refit/core/topology.hpp>
 #include <refit/core/union_find.hpp>
 #include <refit/core/weld.hpp>
 #include <refit/surface/agents.hpp>
@@ -180,25 +181,7 @@ std::vector<std::uint32_t> garment_layers(const Garment& g, double min_area, dou
   // Two pieces or more: join those whose face boundaries (edges of one face,
   // on the welded vertices) come within join_distance of each other.
   if (join_distance > 0.0 && std::count_if(area.begin(), area.end(), is_layer) >= 2) {
-    std::vector<std::uint64_t> edges;
-    edges.reserve(g.faces.indices.size());
-    for (std::size_t f = 0; f < g.faces.rows(); ++f) {
-      auto r = g.faces.row(f);
-      for (std::size_t k = 0; k < r.size(); ++k) {
-        const std::uint64_t a = weld[r[k]], b = weld[r[(k + 1) % r.size()]];
-        if (a != b) edges.push_back(std::min(a, b) << 32 | std::max(a, b));
-      }
-    }
-    tbb::parallel_sort(edges.begin(), edges.end());
-    std::vector<Index> boundary;
-    for (std::size_t i = 0; i < edges.size();) {
-      std::size_t j = i;
-      while (j < edges.size() && edges[j] == edges[i]) ++j;
-      if (j - i == 1) boundary.insert(boundary.end(), {Index(edges[i] >> 32), Index(edges[i] & 0xffffffffULL)});
-      i = j;
-    }
-    std::sort(boundary.begin(), boundary.end());
-    boundary.erase(std::unique(boundary.begin(), boundary.end()), boundary.end());
+    const std::vector<Index> boundary = boundary_vertices(g, weld);
     Points bp(static_cast<Eigen::Index>(boundary.size()), 3);
     for (std::size_t i = 0; i < boundary.size(); ++i) bp.row(Eigen::Index(i)) = x.row(boundary[i]);
     const std::vector<Index> near = weld_points(bp, join_distance);
