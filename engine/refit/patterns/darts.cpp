@@ -124,7 +124,8 @@ std::vector<Index> best_dart(const Garment& g, const PanelSet& set, std::size_t 
   // Measured on the shared skirt: darts of up to half the piece's height
   // reach a p95 of 0.0285, of up to a third (about 26 cm, ending above the
   // hips, as a pattern maker's) 0.034; the shorter ones are kept.
-  const double clearance = 0.06 * span, longest = 0.35 * span;
+  // Darts shorter than a tenth of the piece's height are nicks (on the suit's tabs).
+  const double clearance = 0.06 * span, longest = 0.35 * span, shortest = 0.1 * span;
   const std::vector<double> clear = distances(graph, blocked);
 
   std::vector<double> cost(n, kInf), gain(n, -kInf), length(n, 0.0);
@@ -155,7 +156,7 @@ std::vector<Index> best_dart(const Garment& g, const PanelSet& set, std::size_t 
   }
   Index apex = kNone;
   for (Index v = 0; v < n; ++v)
-    if (parent[v] != kNone && gain[v] > 0 && (apex == kNone || gain[v] > gain[apex])) apex = v;
+    if (parent[v] != kNone && gain[v] > 0 && length[v] >= shortest && (apex == kNone || gain[v] > gain[apex])) apex = v;
   std::vector<Index> path;
   for (Index v = apex; v != kNone; v = parent[v]) path.push_back(p.vertices[v]);
   std::reverse(path.begin(), path.end());

@@ -13,7 +13,8 @@
 // edges, that gains most stretch above the target per unit length (a
 // shortest-path tree whose edges cost their length plus 4 times their sideways
 // part, never climbing: vertical-ish darts), ending where the gain is largest
-// (where the stretch falls under the target). The dart's two sides are a seam
+// (where the stretch falls under the target), a tenth to a third of the
+// piece's height long. The dart's two sides are a seam
 // like any other (pattern.cpp holds them at one length).
 #include <refit/patterns/pattern.hpp>
 
