@@ -8,7 +8,8 @@
 // and lengths; the feature lines of the resized patterns are closer to their
 // original pattern shape after the full pipeline than after the warp alone.
 // Prints the stretch of every garment (issue 16's 0.02 is not reached: about
-// 0.09 on skirt and jeans) and the straightness ratios of the paper's claim
+// 0.09 on skirt and jeans; with automatic darts 0.034 on the skirt and at most
+// 0.09 on the jeans' pieces, asserted) and the straightness ratios of the paper's claim
 // (Fig. 10), whose 3x target is reached on the suit's trousers resized to F_heavier
 // and F_thinner (asserted), not on the jeans (docs/patterns.md).
 #include "support/test_support.hpp"
@@ -16,6 +17,7 @@
 #include <refit/features/feature_file.hpp>
 #include <refit/io/body_io.hpp>
 #include <refit/io/obj_garment.hpp>
+#include <refit/patterns/darts.hpp>
 #include <refit/patterns/grading.hpp>
 #include <refit/patterns/pattern.hpp>
 #include <refit/pipeline/resize.hpp>
@@ -101,6 +103,75 @@ TEST(SharedPatterns, JeansDxfReadsBackWithTheSamePieces) {
   ASSERT_EQ(got.size(), want.size());
   for (std::size_t i = 0; i < got.size(); ++i) EXPECT_NEAR(got[i], want[i], 1e-5 * want[i]);
   EXPECT_EQ(back["polylines"]["FEATURES"].size(), 4u);  // the creases
+}
+
+// Automatic darts (darts.hpp) on the skirt and the jeans: the stretch p95 of
+// every piece before and after, the darts' count and lengths, and their two
+// sides sewn within 0.5 % like every other seam.
+TEST(SharedPatterns, DartsBringTheStretchDown) {
+  if (test::shared_data_dir().empty()) GTEST_SKIP() << "../shared/data is absent: no shared garments to cut darts in";
+  struct DartCase {
+    const char* garment;
+    const char* file;
+    const char* features;
+    double reached;  // the stretch p95 of the worst piece with darts, measured (rounded up)
+  };
+  // Issue 16's 0.02 is not reached: the skirt's hip line and the jeans' knees
+  // and seat stretch beyond the darts' reach from the waist (docs/patterns.md).
+  const DartCase cases[] = {{"skirt", "garments/skirt_on_A_female.obj", nullptr, 0.035},
+                            {"jeans", "garments/jeans_on_A_female.obj", "jeans", 0.09}};
+  std::printf("| garment | panel | p95 before | p95 with darts | darts | dart lengths | worst seam mismatch |\n");
+  for (const DartCase& c : cases) {
+    const Garment g = read_garment_obj(data(c.file));
+    const std::vector<FeatureSpec> specs = c.features ? read_feature_file(features(c.features)) : std::vector<FeatureSpec>{};
+    PatternCut cut = cut_pattern(g, specs, c.file);
+    const PatternOptions options;
+    const Pattern before = flatten_pattern(g, cut, g.positions, options);
+    DartOptions darts;
+    darts.max_stretch = 0.02;
+    const Pattern after = cut_darts(g, cut, options, darts);
+    EXPECT_FALSE(cut.darts.empty()) << c.garment;
+    ASSERT_EQ(after.pieces.size(), before.pieces.size()) << c.garment;
+    for (std::size_t k = 0; k < after.pieces.size(); ++k) {
+      std::string lengths;
+      std::size_t count = 0;
+      for (const Dart& d : cut.darts)
+        if (d.panel == k) {
+          char buf[32];
+          std::snprintf(buf, sizeof buf, "%s%.1f", count++ ? " " : "", d.length_3d);
+          lengths += buf;
+          EXPECT_GE(dart_seam(cut, d), 0) << c.garment << ": a dart is not a seam";
+        }
+      std::printf("| %s | %s | %.4f | %.4f | %zu | %s | %.4f |\n", c.garment, cut.panels.panels[k].name.c_str(),
+                  before.pieces[k].measures.stretch_p95, after.pieces[k].measures.stretch_p95, count, lengths.c_str(),
+                  after.seam_mismatch_max);
+      EXPECT_LT(after.pieces[k].measures.stretch_p95, before.pieces[k].measures.stretch_p95) << c.garment << " " << k;
+      EXPECT_LE(after.pieces[k].measures.stretch_p95, c.reached) << c.garment << " " << k;
+      EXPECT_EQ(after.pieces[k].measures.flipped, 0u) << c.garment << " " << k;
+    }
+    for (std::size_t i = 0; i < after.seams.size(); ++i) EXPECT_LE(after.seams[i].mismatch, 0.005) << c.garment << " seam " << i;
+  }
+}
+
+// `refit flatten --darts auto`: the darts in the report (per panel, with their
+// two sides' 2D lengths) and in the printed summary.
+TEST(SharedPatterns, FlattenCutsDartsIntoTheSkirt) {
+  if (test::shared_data_dir().empty()) GTEST_SKIP() << "../shared/data is absent: no shared skirt to cut darts in";
+  test::TempDir dir;
+  const auto r = test::run_cli("flatten --garment '" + data("garments/skirt_on_A_female.obj") + "' --out-dir '" +
+                               dir.path().string() + "' --name skirt --darts auto");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json report = nlohmann::json::parse(test::read_text(dir.file("skirt.json")));
+  ASSERT_EQ(report["panels"].size(), 1u);
+  const nlohmann::json& darts = report["panels"][0]["darts"];
+  EXPECT_EQ(report["darts"], darts.size());
+  EXPECT_GE(darts.size(), 2u);
+  for (const auto& d : darts) {
+    EXPECT_LE(d["mismatch"].get<double>(), 0.005);
+    EXPECT_GT(d["length_2d"][0].get<double>(), 0.0);
+  }
+  EXPECT_LE(report["stretch_p95"].get<double>(), 0.035);
+  EXPECT_NE(r.out.find(": " + std::to_string(darts.size()) + " darts, "), std::string::npos) << r.out;
 }
 
 // The paper's claim (section 6, Fig. 10): patterns of the resized trousers have

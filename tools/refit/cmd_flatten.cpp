@@ -55,6 +55,20 @@ int run(const FlattenArgs& a) {
   if (!a.quiet) {
     std::printf("%zu panels, stretch p95 %.4f, seam mismatch max %.4f\n", writer.cut().panels.panels.size(),
                 summary["stretch_p95"].get<double>(), summary["seam_mismatch_max"].get<double>());
+    const PatternCut& cut = writer.cut();
+    for (std::size_t k = 0; k < cut.panels.panels.size(); ++k) {
+      std::string lengths;
+      std::size_t count = 0;
+      for (const Dart& d : cut.darts)
+        if (d.panel == k) {
+          char buf[32];
+          std::snprintf(buf, sizeof buf, "%s%.1f", count++ ? ", " : "", d.length_3d);
+          lengths += buf;
+        }
+      if (count > 0)
+        std::printf("%s: %zu dart%s, %s %s long\n", cut.panels.panels[k].name.c_str(), count, count > 1 ? "s" : "",
+                    lengths.c_str(), a.out.units.c_str());
+    }
     for (const auto& key : {"svg", "dxf", "report", "grading_svg"})
       if (summary.contains(key)) std::printf("wrote %s\n", summary[key].get<std::string>().c_str());
   }

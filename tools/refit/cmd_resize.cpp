@@ -370,6 +370,7 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
   app.add_option("--patterns-out", a->patterns.dir,
                  "Folder for each result's 2D patterns and grading view against the original (BODY.svg, .dxf, .json, "
                  "-grading.svg; seam curves of --features cut; docs/patterns.md)");
+  add_pattern_options(app, a->patterns, "Advanced patterns (--patterns-out; docs/patterns.md)", "Patterns (with --patterns-out)");
   app.add_option("--curves-out", a->curves_out, "Write original, warped and optimised feature curves (OBJ l lines)");
   app.add_flag("--paper-closeness", a->paper_closeness,
                "Feature closeness term as the paper's plain sums (weak: keeps most of the warp's bend)")

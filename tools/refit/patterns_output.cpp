@@ -21,13 +21,27 @@ void write_text(const std::string& path, const std::string& text) {
 
 }  // namespace
 
-void add_pattern_options(CLI::App& app, PatternsOptions& o, const std::string& advanced) {
-  app.add_option("--sheet-units", o.sheet_units, "Units of the SVG: cm or mm (true scale either way)")
-      ->check(CLI::IsMember({"cm", "mm"}))
-      ->capture_default_str();
-  app.add_flag("--stretch-map", o.stretch_map, "Colour the SVG's pieces by their stretch against 3D");
-  app.add_flag("--skip-unflattenable", o.skip_unflattenable,
-               "Leave out panels that cannot be flattened (with a warning) instead of failing");
+void add_pattern_options(CLI::App& app, PatternsOptions& o, const std::string& advanced, const std::string& group) {
+  std::vector<CLI::Option*> main;
+  main.push_back(app.add_option("--sheet-units", o.sheet_units, "Units of the SVG: cm or mm (true scale either way)")
+                     ->check(CLI::IsMember({"cm", "mm"}))
+                     ->capture_default_str());
+  main.push_back(app.add_flag("--stretch-map", o.stretch_map, "Colour the SVG's pieces by their stretch against 3D"));
+  main.push_back(app.add_flag("--skip-unflattenable", o.skip_unflattenable,
+                              "Leave out panels that cannot be flattened (with a warning) instead of failing"));
+  main.push_back(app.add_option("--darts", o.darts,
+                                "auto: cut darts from the waistline where a piece stretches more than --dart-target "
+                                "(95th percentile of its faces); none: no darts")
+                     ->check(CLI::IsMember({"auto", "none"}))
+                     ->capture_default_str());
+  main.push_back(app.add_option("--dart-target", o.dart.max_stretch, "With --darts auto: the stretch p95 each piece is cut down to")
+                     ->check(CLI::Range(1e-4, 1.0))
+                     ->capture_default_str());
+  main.push_back(app.add_option("--max-darts", o.dart.max_per_panel, "With --darts auto: darts per piece, at most")
+                     ->check(CLI::Range(0, 100))
+                     ->capture_default_str());
+  if (!group.empty())
+    for (CLI::Option* opt : main) opt->group(group);
   app.add_option("--boundary-weight", o.flatten.boundary_weight,
                  "Weight that keeps the pieces' outlines at their 3D length (0 = plain ARAP; seams then agree less)")
       ->check(CLI::Range(0.0, 1e6))
@@ -63,6 +77,8 @@ PatternWriter::PatternWriter(std::shared_ptr<const Garment> original, const std:
   pattern_options_.flatten = options_.flatten;
   pattern_options_.margin = 2.0 / (100.0 * metres_per_unit(options_.units));  // 2 cm
   cut_ = cut_pattern(*garment_, specs, garment_file, features_file);
+  unflattenable_panels(cut_, options_.skip_unflattenable);  // refused before any work
+  if (options_.darts == "auto") original_ = cut_darts(*garment_, cut_, pattern_options_, options_.dart);
 }
 
 const Pattern& PatternWriter::original_pattern() const {
@@ -93,6 +109,7 @@ nlohmann::json PatternWriter::write(const std::string& name, const Points& posit
                             {"dxf", paths[1]},
                             {"report", paths[2]},
                             {"panels", cut_.panels.panels.size()},
+                            {"darts", report["darts"]},
                             {"stretch_p95", pattern.stretch_p95},
                             {"seam_mismatch_max", pattern.seam_mismatch_max},
                             {"warnings", pattern.warnings}};

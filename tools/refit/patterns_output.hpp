@@ -4,6 +4,7 @@
 // flattened once; each state written gives DIR/NAME.svg, DIR/NAME.dxf,
 // DIR/NAME.json and, when graded against the original, DIR/NAME-grading.svg.
 #include <refit/features/feature_file.hpp>
+#include <refit/patterns/darts.hpp>
 #include <refit/patterns/pattern.hpp>
 
 #include <CLI/CLI.hpp>
@@ -22,12 +23,16 @@ struct PatternsOptions {
   std::string units = "cm";        // of the garment (and the DXF)
   bool stretch_map = false;
   bool skip_unflattenable = false;
+  std::string darts = "none";  // auto: cut darts where a piece stretches more than dart.max_stretch
+  DartOptions dart{0.02, 6};
   FlattenOptions flatten;
 };
 
 /// Adds the pattern options shared by `flatten` and `resize --patterns-out`
-/// (sheet units, stretch map, skipping, and the flattening's advanced knobs).
-void add_pattern_options(CLI::App& app, PatternsOptions& o, const std::string& advanced_group);
+/// (sheet units, stretch map, skipping, darts, and the flattening's advanced
+/// knobs in `advanced_group`); all in `group` when it is not empty.
+void add_pattern_options(CLI::App& app, PatternsOptions& o, const std::string& advanced_group,
+                         const std::string& group = "");
 
 inline PatternsOptions with_units(PatternsOptions o, const std::string& units) {
   o.units = units;
@@ -39,7 +44,8 @@ std::vector<std::string> pattern_paths(const std::string& dir, const std::string
 
 class PatternWriter {
  public:
-  /// Cuts `original` along its groups, UV seams and the seam curves of `specs`.
+  /// Cuts `original` along its groups, UV seams and the seam curves of `specs`,
+  /// and with darts "auto" cuts darts too (flattening the original once).
   PatternWriter(std::shared_ptr<const Garment> original, const std::vector<FeatureSpec>& specs,
                 const std::string& garment_file, const std::string& features_file, PatternsOptions options);
 

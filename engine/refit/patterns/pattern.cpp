@@ -70,18 +70,24 @@ PatternCut cut_pattern(const Garment& original, const std::vector<FeatureSpec>& 
   return cut;
 }
 
+std::vector<std::string> unflattenable_panels(const PatternCut& cut, bool skip) {
+  std::vector<std::string> warnings;
+  for (const Panel& p : cut.panels.panels) {
+    if (p.problem.empty()) continue;
+    const std::string what = "panel '" + p.name + "' (" + std::to_string(p.faces.size()) + " faces) cannot be flattened: " + p.problem;
+    if (!skip) throw input_error(cut.file, what);
+    warnings.push_back(what + "; left out");
+  }
+  return warnings;
+}
+
 Pattern flatten_pattern(const Garment& g, const PatternCut& cut, const Points& positions, const PatternOptions& options) {
   const std::vector<Panel>& panels = cut.panels.panels;
   if (positions.rows() != static_cast<Eigen::Index>(g.vertex_count()))
     throw Error("flatten: " + std::to_string(positions.rows()) + " positions for a garment of " +
                 std::to_string(g.vertex_count()) + " vertices");
   Pattern out;
-  for (const Panel& p : panels) {
-    if (p.problem.empty()) continue;
-    const std::string what = "panel '" + p.name + "' (" + std::to_string(p.faces.size()) + " faces) cannot be flattened: " + p.problem;
-    if (!options.skip_unflattenable) throw input_error(cut.file, what);
-    out.warnings.push_back(what + "; left out");
-  }
+  out.warnings = unflattenable_panels(cut, options.skip_unflattenable);
   out.pieces.resize(panels.size());
   std::vector<Points> xyz(panels.size());
   const auto flatten_all = [&](const std::vector<std::vector<HeldEdge>>* held) {

@@ -23,11 +23,19 @@
 
 namespace refit {
 
+/// A dart cut into a panel (darts.hpp): a slit from the panel's edge to its apex.
+struct Dart {
+  Index panel = 0;
+  std::vector<Index> garment_path;  // garment vertices from the edge (the waistline) to the apex
+  double length_3d = 0;             // on the garment it was cut on
+};
+
 struct PatternCut {
   std::string file;                // the garment file, for messages
   PanelSet panels;
   std::vector<SeamPath> seam_paths;  // the seam curves' edge paths
   std::vector<FeatureLine> lines;    // the shape curves, per panel
+  std::vector<Dart> darts;           // automatic darts (darts.hpp); their sides are seams of `panels`
 };
 
 /// Cuts `original` (see above): groups, UV seams and the seam curves of `specs`;
@@ -75,6 +83,10 @@ struct Pattern {
   double seam_mismatch_max = 0;
   std::vector<std::string> warnings;
 };
+
+/// The warnings for the panels of `cut` that cannot be flattened; throws the
+/// first as refit::Error (see above) unless `skip`.
+std::vector<std::string> unflattenable_panels(const PatternCut& cut, bool skip);
 
 /// Flattens the garment state `positions` (same vertices as the cut's garment)
 /// piece by piece (in parallel), measures it and lays it out.

@@ -1,6 +1,7 @@
 // The pattern report; see report.hpp.
 #include <refit/patterns/report.hpp>
 
+#include <refit/patterns/darts.hpp>
 #include <refit/patterns/lengths.hpp>
 
 namespace refit {
@@ -50,6 +51,19 @@ nlohmann::json pattern_report(const Garment& g, const PatternCut& cut, const Pat
                            {"length_2d", rows_length(line_points(line, cut.panels, g, piece.uv), line.closed)}});
       j["feature_lines"] = lines;
     }
+    json darts = json::array();
+    for (const Dart& d : cut.darts) {
+      if (d.panel != k) continue;
+      json dj = {{"vertices", d.garment_path.size()}, {"length_3d", indexed_length(positions, d.garment_path, false)}};
+      const long s = dart_seam(cut, d);
+      if (s >= 0 && piece.flattened) {
+        const SeamMeasure& m = pattern.seams[static_cast<std::size_t>(s)];
+        dj["length_2d"] = {m.length_2d[0], m.length_2d[1]};
+        dj["mismatch"] = m.mismatch;
+      }
+      darts.push_back(dj);
+    }
+    j["darts"] = darts;
     panels.push_back(j);
   }
   json seams = json::array();
@@ -71,6 +85,7 @@ nlohmann::json pattern_report(const Garment& g, const PatternCut& cut, const Pat
           {"panels_total", ps.panels.size()},
           {"stretch_p95", pattern.stretch_p95},
           {"seam_mismatch_max", pattern.seam_mismatch_max},
+          {"darts", cut.darts.size()},
           {"cuts", {{"uv_seam_edges", ps.uv_seam_edges}, {"group_edges", ps.group_edges},
                     {"seam_curve_edges", ps.curve_edges}, {"non_manifold_edges", ps.non_manifold_edges}}},
           {"seam_curves", curves},
