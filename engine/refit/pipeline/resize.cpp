@@ -3,7 +3,6 @@
 #include <refit/features/curve_metrics.hpp>
 #include <refit/features/feature_curves.hpp>
 #include <refit/collision/collision.hpp>
-#include <refit/collision/distance_hold.hpp>
 #include <refit/io/obj_garment.hpp>
 #include <refit/metrics/metrics.hpp>
 #include <refit/pipeline/resize.hpp>
@@ -129,8 +128,6 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
     } catch (const Error& e) {  // e.g. a voxel size too small for the garment: name its file
       throw input_error(garment_->source ? garment_->source->file : "garment", e.what());
     }
-    if (options_.collision && options_.hold_distance)
-      near_body_a_ = near_body_distances(garment_->positions, BodySurface(body_a_.mesh()), options_.hold_band_cm * per_cm);
     bind_report_["surface"] = clock.ms();
   }
 }
@@ -284,16 +281,6 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
     if (!curves.curves.empty()) {
       pinned = feature_corners(feature_attachment_, result.positions.rows());
       co.pinned = &pinned;
-    }
-    if (!near_body_a_.empty()) {
-      DistanceHoldOptions ho;
-      ho.tolerance *= per_cm;  // the defaults are in cm
-      ho.reach *= per_cm;
-      if (!pinned.empty()) ho.pinned = &pinned;
-      report["distance_hold"] = hold_body_distance(*garment_, result.positions, surface_b, near_body_a_, ho).to_json();
-      // Where the body's closest point is not unique (a vertex on the spine's
-      // groove) the hold's direction picks one side.
-      if (symmetric_b) symmetrise(result.positions);
     }
     const CollisionReport c = resolve_penetrations(*garment_, result.positions, surface_b, co);
     timings["collision"] = clock.ms();

@@ -35,8 +35,6 @@ struct ResizeOptions {
   SurfaceOptions surface;      // epsilon and voxel in cm here; converted to garment units
   bool collision = true;       // push vertices inside body B out (beyond the paper)
   double clearance_cm = 0.2;   // ... to this distance outside the body
-  bool hold_distance = false;  // vertices near body A keep their distance on body B (with the collision step; off: docs/method.md)
-  double hold_band_cm = 1.25;  // ... those within this distance outside body A (beyond 1 cm: held, not dragged by held neighbours)
   bool metrics = false;        // add fit, penetration and sanity metrics (warp and result) to the report
   double memory_budget_mb = 0; // a run estimated above this is refused before the work (0: the machine's memory)
 };
@@ -82,7 +80,6 @@ class GarmentBinding {
   WarpBinding warp_;
   std::optional<FeatureBinding> features_;
   std::optional<SurfaceBinding> surface_;
-  std::vector<double> near_body_a_;  // per garment vertex: its distance to body A when held (distance_hold.hpp), else NaN
   SurfaceAttachment feature_attachment_;  // where the feature samples (all curves, in order) sit on the garment
   nlohmann::json bind_report_;
   double memory_estimate_mb_ = 0.0;
