@@ -271,8 +271,7 @@ int run(ResizeArgs a) {
     obj.emplace(a.garment);
     size = {obj->bytes(), obj->vertex_count(), obj->face_count()};
   }
-  SurfaceOptions so = options.surface;
-  so.voxel *= units_per_cm(options.units);
+  const SurfaceOptions so = surface_options_in_units(options);
   const double in_memory_mb =
       estimated_memory_mb(size.vertices, options.stage == Stage::Full ? estimated_agents(size.vertices, so.agent_budget, so.voxel) : 0.0,
                           body_a.triangles.size());

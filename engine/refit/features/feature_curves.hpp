@@ -29,6 +29,10 @@ struct FeatureCurve {
   double spacing() const;
 };
 
+/// Every curve's samples, one curve after another: the order in which a
+/// binding numbers the samples of all curves.
+Points all_samples(const std::vector<FeatureCurve>& curves);
+
 struct FeatureCurveOptions {
   std::size_t aux_per_sample = 4;
   double aux_radius = 3.0;     // auxiliary points lie within this many sample spacings of their sample

@@ -50,6 +50,10 @@ std::vector<FeatureCurve> add_mirrored_curves(std::vector<FeatureCurve> curves, 
 /// sample nearest its mirror about x = c, or -1 when none is within `tolerance`.
 inline constexpr Index kNoMirror = static_cast<Index>(-1);
 std::vector<Index> mirror_pairs(const Points& samples, double c, double tolerance);
+/// mirror_pairs of all_samples(curves) within half the finest curve's spacing:
+/// pairs only where the mirror image is a sample (a mirrored copy, a hem, a
+/// profile on the plane).
+std::vector<Index> sample_mirror_pairs(const std::vector<FeatureCurve>& curves, double c);
 
 /// Makes `points` (rows matching mirror_pairs' samples) mirror-symmetric: each
 /// paired row becomes the mean of itself and its partner's mirror image.

@@ -11,7 +11,6 @@
 #include <refit/pipeline/units.hpp>
 
 #include <cstdio>
-#include <limits>
 #include <optional>
 
 namespace refit {
@@ -34,6 +33,15 @@ nlohmann::json garment_summary(const Garment& g) {
           {"faces", g.faces.rows()},
           {"lines", g.lines.rows()},
           {"points", g.points.rows()}};
+}
+
+SurfaceOptions surface_options_in_units(const ResizeOptions& options) {
+  const double per_cm = units_per_cm(options.units);
+  SurfaceOptions so = options.surface;
+  so.epsilon *= per_cm;
+  so.voxel *= per_cm;
+  so.clearance = 2.0 * options.clearance_cm * per_cm;
+  return so;
 }
 
 GarmentBinding::~GarmentBinding() = default;
@@ -97,29 +105,14 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
     // the collision step finds nothing to move on them (issue 13: the written garment follows the curves).
     if (options_.collision && sm.clearance <= 0.0) sm.clearance = (options_.clearance_cm + kFeatureClearanceMarginCm) * per_cm;
     features_ = bind_features(body_a_, std::move(curves), sm);
-    if (sym.symmetric) {
-      // Pairs only where the mirror image is a sample (the mirrored copies, a hem, a profile on the plane).
-      double spacing = std::numeric_limits<double>::infinity();
-      std::vector<const Points*> samples;
-      for (const FeatureCurve& c : features_->model.curves) {
-        samples.push_back(&c.samples);
-        spacing = std::min(spacing, c.spacing());
-      }
-      feature_mirror_ = mirror_pairs(concat_rows(samples), mirror_x_, 0.5 * spacing);
-    }
+    if (sym.symmetric) feature_mirror_ = sample_mirror_pairs(features_->model.curves, mirror_x_);
     bind_report_["features"] = clock.ms();
   }
   if (options_.stage == Stage::Full) {
     clock.reset();
     progress.stage("building the agent system");
-    SurfaceOptions so = options_.surface;
-    so.epsilon *= per_cm;
-    so.voxel *= per_cm;
-    so.clearance = 2.0 * options_.clearance_cm * per_cm;
-    std::vector<const Points*> samples;
-    if (features_)
-      for (const FeatureCurve& c : features_->model.curves) samples.push_back(&c.samples);
-    const Points all = concat_rows(samples);
+    const SurfaceOptions so = surface_options_in_units(options_);
+    const Points all = features_ ? all_samples(features_->model.curves) : Points(0, 3);
     // One pass over the garment for every curve's samples; the surface binding
     // and the report's shape_error_output share it.
     if (all.rows() > 0) feature_attachment_ = locate().attach(all);
@@ -135,8 +128,7 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
 // What a run will need, from the sizes alone (issue 17): refused before the work
 // when above the budget or this machine's memory, and given in the report.
 void GarmentBinding::check_memory_estimate() {
-  SurfaceOptions so = options_.surface;
-  so.voxel *= units_per_cm(options_.units);
+  const SurfaceOptions so = surface_options_in_units(options_);
   double agents = 0.0;
   try {
     if (options_.stage == Stage::Full) agents = estimated_agent_count(*garment_, so);

@@ -85,6 +85,10 @@ class GarmentBinding {
   double memory_estimate_mb_ = 0.0;
 };
 
+/// The surface step's options in garment units: `options.surface` keeps epsilon
+/// and voxel in cm, and the agents keep clear of body B by twice the collision clearance.
+SurfaceOptions surface_options_in_units(const ResizeOptions& options);
+
 /// The report's fixed part: garment counts.
 nlohmann::json garment_summary(const Garment& g);
 

@@ -2,6 +2,7 @@
 // The parts of a resize report that the in-memory pipeline (resize.cpp) and the
 // chunked one (refit/chunked) share, so both give the same report.
 #include <refit/features/shape_matching.hpp>
+#include <refit/features/symmetry.hpp>
 #include <refit/surface/surface.hpp>
 
 #include <nlohmann/json.hpp>
@@ -12,6 +13,10 @@ namespace refit {
 
 /// The rows of `parts`, one after another.
 Points concat_rows(const std::vector<const Points*>& parts);
+
+/// The report's "symmetry" object as the binding finds it (body B's figures
+/// and the mirrored curves' names are added later).
+nlohmann::json symmetry_report(const SymmetryCheck& sym);
 
 /// The report's "surface" object.
 nlohmann::json surface_report(const SurfaceStats& s);
