@@ -21,6 +21,8 @@
 
 namespace refit {
 
+class BodySurface;
+
 /// How far a resize goes: the warp alone (step 1), warp + feature curves (steps
 /// 1-2: the garment is the warp, the curves are optimised), or all three steps.
 enum class Stage { Warp, Features, Full };
@@ -68,6 +70,18 @@ class GarmentBinding {
 
  private:
   void check_memory_estimate();
+  // The steps of resize(), in the paper's order; each adds its part of the
+  // report, its time and its warnings to `result`.
+  TriangleFrames warp_step(const BodyMesh& body_b, ResizeResult& result, const Progress& progress) const;
+  bool body_b_symmetric(const BodyMesh& body_b, nlohmann::json& report) const;
+  void feature_step(const TriangleFrames& frames_b, const BodySurface& surface_b, bool symmetric_b,
+                    const Stopwatch& clock, ResizeResult& result, const Progress& progress) const;
+  Points surface_step(const BodySurface& surface_b, bool symmetric_b, ResizeResult& result,
+                      const Progress& progress) const;  // returns the features where the surface step leaves them
+  void collision_step(const BodySurface& surface_b, ResizeResult& result, const Progress& progress) const;
+  void metrics_step(const BodySurface& surface_b, ResizeResult& result, const Progress& progress) const;
+  void symmetrise_garment(Points& positions) const;
+
   std::shared_ptr<const Garment> garment_;
   ResizeOptions options_;
   nlohmann::json symmetry_report_;
