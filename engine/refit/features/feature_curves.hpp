@@ -1,6 +1,6 @@
 #pragma once
-// From feature specifications to sampled feature curves on the ORIGINAL garment
-// (paper section 4.2, Fig. 3(d)), with the auxiliary points of section 4.3.
+// From feature specifications to sampled feature curves on the ORIGINAL garment (paper section 4.2, Fig. 3(d)),
+// with the auxiliary points of section 4.3. Lengths in the garment's units; plain functions of their arguments.
 #include <refit/core/garment.hpp>
 #include <refit/features/feature_file.hpp>
 #include <refit/features/plane.hpp>

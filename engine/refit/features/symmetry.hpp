@@ -3,7 +3,7 @@
 // item 2). When the pair is mirror-symmetric, every feature curve acts on its
 // mirror image too: a curve whose mirror is not already a feature (the left
 // profile, but not a front profile lying on the plane) gets a mirrored copy, so
-// the feature and surface steps treat both sides alike.
+// the feature and surface steps treat both sides alike. Lengths in the garment's units; plain functions.
 #include <refit/features/feature_curves.hpp>
 #include <refit/features/shape_matching.hpp>
 

@@ -1,7 +1,14 @@
 #pragma once
 // The resize pipeline: the paper's three steps, read top to bottom in
-// GarmentBinding::resize. Bind once (garment + body A + features), apply to
-// any number of bodies B.
+// GarmentBinding::resize: the warp (section 3, eqs. 1-4), the feature curves
+// (section 4, eqs. 5-9), the surface (section 5, eqs. 10-15), then the collision
+// step and the report (beyond the paper). Bind once (garment + body A +
+// features), apply to any number of bodies B.
+// Units: positions in the garment's units (ResizeOptions::units); the physical
+// constants of ResizeOptions are in cm and converted. Threads: the binding is
+// read-only after construction and resize() is const; each step runs in
+// parallel inside (core/parallel.hpp), with bit-identical results for any
+// thread count. Bad input: refit::Error, its message naming the file.
 #include <refit/body/body_mesh.hpp>
 #include <refit/core/garment.hpp>
 #include <refit/core/progress.hpp>

@@ -1,6 +1,7 @@
 #pragma once
 // The parts of a resize report that the in-memory pipeline (resize.cpp) and the
-// chunked one (refit/chunked) share, so both give the same report.
+// chunked one (refit/chunked) share, so both give the same report. Lengths in
+// the garment's units, times in ms; plain functions of their arguments.
 #include <refit/features/shape_matching.hpp>
 #include <refit/features/symmetry.hpp>
 #include <refit/surface/surface.hpp>
