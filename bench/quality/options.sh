@@ -7,7 +7,7 @@ set -euo pipefail
 refit="${1:-build/release/tools/refit}"
 here="$(cd "$(dirname "$0")" && pwd)"
 variants=("" "--method paper" "--no-collision" "--symmetry none" "--clearance 0.5" "--feature-zone 0"
-          "--feature-zone 3" "--epsilon 0.5" "--epsilon 2" "--no-layers" "--encode-on-warped" "--paper-closeness"
+          "--feature-zone 3" "--epsilon 0.5" "--epsilon 2" "--no-layers" "--encode-on-warped" "--paper-closeness" "--ordered-features"
           "--paper-surface" "--plain-sweeps" "--v-cycles" "--max-triangles 8" "--agents 5000")
 echo "| option | flipped | inside v / faces | near-body change cm | mirror - warp's cm | height ratio / warp's | features vs warp (least) | between vs warp (least) | feature gap cm |"
 echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|"

@@ -32,7 +32,7 @@ struct ResizeArgs {
   std::vector<std::string> to_outputs;  // with --to-list: the output of each body of `to`
   std::size_t threads = 0, max_triangles = WarpOptions{}.max_triangles;
   bool quiet = false, metrics = false, paper_closeness = false, no_shape_control = false, no_collision = false,
-       distance_hold = false, encode_on_warped = false, paper_surface = false, plain_sweeps = false, v_cycles = false,
+       encode_on_warped = false, paper_surface = false, plain_sweeps = false, v_cycles = false,
        ordered_features = false;
   SurfaceOptions surface;
   double clearance = 0.2;
@@ -225,7 +225,6 @@ int run(ResizeArgs a) {
     options.surface.follow_body_scale = false;
   }
   options.collision = !(a.no_collision || paper);
-  options.hold_distance = a.distance_hold;
   options.symmetry = parse_symmetry(!a.symmetry.empty() ? a.symmetry : paper ? "none" : "auto");
   options.metrics = a.metrics;
   options.clearance_cm = a.clearance;
@@ -272,8 +271,7 @@ int run(ResizeArgs a) {
     obj.emplace(a.garment);
     size = {obj->bytes(), obj->vertex_count(), obj->face_count()};
   }
-  SurfaceOptions so = options.surface;
-  so.voxel *= units_per_cm(options.units);
+  const SurfaceOptions so = surface_options_in_units(options);
   const double in_memory_mb =
       estimated_memory_mb(size.vertices, options.stage == Stage::Full ? estimated_agents(size.vertices, so.agent_budget, so.voxel) : 0.0,
                           body_a.triangles.size());
@@ -426,8 +424,6 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
                  "auto: mirror each one-sided feature about x = c when garment and body A are mirror-symmetric; "
                  "x: always; none: never (default: auto; none with --method paper; docs/features.md)");
   app.add_flag("--no-collision", a->no_collision, "Do not push vertices inside body B out");
-  app.add_flag("--distance-hold", a->distance_hold,
-               "With the collision step: move vertices that sat near body A to their distance on body B first (docs/method.md)");
   app.add_option("--clearance", a->clearance, "Collision clearance outside body B in cm (0 to 10)")
       ->check(check_clearance)
       ->capture_default_str();

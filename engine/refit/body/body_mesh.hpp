@@ -1,6 +1,6 @@
 #pragma once
-// A human body: a triangle mesh. Bodies A and B must share their triangle list
-// (same connectivity), so triangle i on A corresponds to triangle i on B.
+// A human body: a triangle mesh, in the garment's units. Bodies A and B must share their triangle list (same
+// connectivity), so triangle i on A corresponds to triangle i on B. A plain value, read from any number of threads.
 #include <refit/core/types.hpp>
 
 #include <array>

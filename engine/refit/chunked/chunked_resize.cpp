@@ -123,9 +123,7 @@ ChunkedBinding::ChunkedBinding(std::shared_ptr<const GarmentStore> garment, Body
   } else {
     bound_->mirror.reset();
   }
-  bound_->symmetry_report = {{"plane_x", sym.plane_x},          {"garment_error", sym.garment_error},
-                             {"body_a_error", sym.body_error},  {"tolerance", sym.tolerance},
-                             {"symmetric", sym.symmetric},      {"mirrored_features", nlohmann::json::array()}};
+  bound_->symmetry_report = symmetry_report(sym);
   bind_report_["symmetry"] = clock.ms();
   if (!features.empty()) {
     clock.reset();
@@ -135,29 +133,14 @@ ChunkedBinding::ChunkedBinding(std::shared_ptr<const GarmentStore> garment, Body
     if (sym.symmetric) curves = add_mirrored_curves(std::move(curves), sym.plane_x);
     for (std::size_t i = given; i < curves.size(); ++i) bound_->symmetry_report["mirrored_features"].push_back(curves[i].name);
     bound_->features = bind_features(body_a_, std::move(curves), options_.shape_matching);
-    if (sym.symmetric) {
-      // Pairs only where the mirror image is a sample (the mirrored copies, a hem, a profile on the plane).
-      double spacing = std::numeric_limits<double>::infinity();
-      std::vector<const Points*> samples;
-      for (const FeatureCurve& c : bound_->features->model.curves) {
-        samples.push_back(&c.samples);
-        spacing = std::min(spacing, c.spacing());
-      }
-      bound_->feature_mirror = mirror_pairs(concat_rows(samples), bound_->mirror_x, 0.5 * spacing);
-    }
+    if (sym.symmetric) bound_->feature_mirror = sample_mirror_pairs(bound_->features->model.curves, bound_->mirror_x);
     bind_report_["features"] = clock.ms();
   }
   if (options_.stage == Stage::Full) {
     clock.reset();
     progress.stage("building the agent system");
-    SurfaceOptions so = options_.surface;
-    so.epsilon *= per_cm;
-    so.voxel *= per_cm;
-    so.clearance = 2.0 * options_.clearance_cm * per_cm;
-    std::vector<const Points*> samples;
-    if (bound_->features)
-      for (const FeatureCurve& c : bound_->features->model.curves) samples.push_back(&c.samples);
-    const Points all = concat_rows(samples);
+    const SurfaceOptions so = surface_options_in_units(options_);
+    const Points all = bound_->features ? all_samples(bound_->features->model.curves) : Points(0, 3);
     if (all.rows() > 0) bound_->feature_attachment = chunked_attach(g, x, plan_, all);
     std::vector<std::uint32_t> layers;
     try {

@@ -4,7 +4,10 @@
 // at a time; only the bodies, the agents, the feature curves, the current
 // chunk and a few bytes per vertex are in memory. The written garment is
 // byte-identical to GarmentBinding's (docs/chunked.md says how each stage
-// gets there).
+// gets there). Units, threads and errors as GarmentBinding's
+// (pipeline/resize.hpp); results are the same bits for any thread count and
+// any chunk size. The collision step and the metrics are refused
+// (check_chunked_options), before any work.
 #include <refit/chunked/chunk_plan.hpp>
 #include <refit/chunked/garment_store.hpp>
 #include <refit/pipeline/resize.hpp>

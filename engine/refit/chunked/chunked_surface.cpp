@@ -33,6 +33,30 @@ double face_area(const ElementBlock& b, std::size_t f) {
   return a;
 }
 
+// Each piece of a block's elements (a face's fan triangles from t = 1, a line's
+// segments from t = 0) subdivided m = subdivide(o, t) times, at corner entry
+// o + t, and each element's first sample within the block: the sums of count(m).
+struct PieceSamples {
+  std::vector<std::uint32_t> m;             // per corner entry
+  std::vector<std::uint64_t> first_sample;  // per element, and the block's total last
+};
+
+template <class Subdivide, class Count>
+PieceSamples piece_samples(const ElementBlock& b, std::size_t first_piece, Subdivide&& subdivide, Count&& count) {
+  const std::size_t n = b.rows.rows();
+  PieceSamples p{std::vector<std::uint32_t>(b.rows.indices.size(), 0), std::vector<std::uint64_t>(n + 1, 0)};
+  for (std::size_t e = 0; e < n; ++e) {
+    const std::size_t o = b.rows.offsets[e];
+    std::uint64_t c = 0;
+    for (std::size_t t = first_piece; t + 1 < b.rows.row_size(e); ++t) {
+      p.m[o + t] = subdivide(o, t);
+      c += count(p.m[o + t]);
+    }
+    p.first_sample[e + 1] = p.first_sample[e] + c;
+  }
+  return p;
+}
+
 }  // namespace
 
 std::pair<double, double> chunked_surface_measure(const GarmentStore& g, const PointGather& x, const ChunkPlan& plan) {
@@ -211,54 +235,42 @@ GarmentAgents chunked_select_agents(const GarmentStore& g, const PointGather& x,
   // Face samples: numbered after the vertices, face by face.
   for_each_block(g.faces(), plan.chunk_faces, x, [&](const ElementBlock& b) {
     const std::size_t nf = b.rows.rows();
-    std::vector<std::uint64_t> first_sample(nf + 1, 0);
-    std::vector<std::uint32_t> m(b.rows.indices.size(), 0);
-    for (std::size_t f = 0; f < nf; ++f) {
-      const std::size_t o = b.rows.offsets[f];
-      std::uint64_t c = 0;
-      for (std::size_t t = 1; t + 1 < b.rows.row_size(f); ++t) {
-        m[o + t] = face_subdivision(tri_area(b.corner(o), b.corner(o + t), b.corner(o + t + 1)), spacing);
-        c += std::uint64_t(m[o + t]) * m[o + t];
-      }
-      first_sample[f + 1] = first_sample[f] + c;
-    }
+    const PieceSamples p = piece_samples(
+        b, 1,
+        [&](std::size_t o, std::size_t t) {
+          return face_subdivision(tri_area(b.corner(o), b.corner(o + t), b.corner(o + t + 1)), spacing);
+        },
+        [](std::uint32_t m) { return std::uint64_t(m) * m; });  // an m x m lattice
     parallel_offer(nf, [&](std::size_t f, auto&& emit) {
       const auto r = b.rows.row(f);
       const std::size_t o = b.rows.offsets[f];
-      std::uint64_t k = total + first_sample[f];
+      std::uint64_t k = total + p.first_sample[f];
       for (std::size_t t = 1; t + 1 < r.size(); ++t)
-        for (std::uint32_t q = 0; q < m[o + t] * m[o + t]; ++q) {
-          const Sample s{{r[0], r[t], r[t + 1]}, lattice_point(m[o + t], q)};
+        for (std::uint32_t q = 0; q < p.m[o + t] * p.m[o + t]; ++q) {
+          const Sample s{{r[0], r[t], r[t + 1]}, lattice_point(p.m[o + t], q)};
           emit(sample_key(grid, sample_position(s, b.corner(o), b.corner(o + t), b.corner(o + t + 1)), k++, layer_of(r[0])), s);
         }
     });
-    total += first_sample[nf];
+    total += p.first_sample[nf];
   });
   for_each_block(g.lines(), plan.chunk_faces, x, [&](const ElementBlock& b) {
     const std::size_t nl = b.rows.rows();
-    std::vector<std::uint64_t> first_sample(nl + 1, 0);
-    std::vector<std::uint32_t> m(b.rows.indices.size(), 0);
-    for (std::size_t l = 0; l < nl; ++l) {
-      const std::size_t o = b.rows.offsets[l];
-      std::uint64_t c = 0;
-      for (std::size_t t = 0; t + 1 < b.rows.row_size(l); ++t) {
-        m[o + t] = segment_samples((b.corner(o + t + 1) - b.corner(o + t)).norm(), spacing);
-        c += m[o + t] > 0 ? m[o + t] - 1 : 0;
-      }
-      first_sample[l + 1] = first_sample[l] + c;
-    }
+    const PieceSamples p = piece_samples(
+        b, 0,
+        [&](std::size_t o, std::size_t t) { return segment_samples((b.corner(o + t + 1) - b.corner(o + t)).norm(), spacing); },
+        [](std::uint32_t m) { return std::uint64_t(m > 0 ? m - 1 : 0); });  // the inner division points
     parallel_offer(nl, [&](std::size_t l, auto&& emit) {
       const auto r = b.rows.row(l);
       const std::size_t o = b.rows.offsets[l];
-      std::uint64_t k = total + first_sample[l];
+      std::uint64_t k = total + p.first_sample[l];
       for (std::size_t t = 0; t + 1 < r.size(); ++t)
-        for (std::uint32_t q = 1; q < m[o + t]; ++q) {
-          const double u = double(q) / m[o + t];
+        for (std::uint32_t q = 1; q < p.m[o + t]; ++q) {
+          const double u = double(q) / p.m[o + t];
           const Sample s{{r[t], r[t + 1], r[t]}, {1.0 - u, u, 0.0}};
           emit(sample_key(grid, sample_position(s, b.corner(o + t), b.corner(o + t + 1), b.corner(o + t)), k++, layer_of(r[t])), s);
         }
     });
-    total += first_sample[nl];
+    total += p.first_sample[nl];
   });
   if (total >= (1ull << 32)) throw Error("surface: more than 2^32 samples; use a larger voxel size");
 

@@ -4,6 +4,8 @@
 // with an interior point that is, move out along the body's closest-point
 // normal, and the correction is spread smoothly over their neighbours so no
 // spikes appear; vertices near the body are lifted by at most what they need.
+// Units: the garment's (CollisionOptions' lengths; the pipeline converts its
+// cm defaults). Threads: parallel inside, the same bits for any thread count.
 #include <refit/body/body_surface.hpp>
 #include <refit/core/garment.hpp>
 

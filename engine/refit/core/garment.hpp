@@ -1,8 +1,8 @@
 #pragma once
-// The garment data model: positions SoA plus polygon faces, polylines (`l`) and
-// points (`p`) in CSR form. Faces may be of any size and non-manifold; vertices
-// may be used by nothing. `source` keeps the original file text so a writer can
-// give the file back line for line with only the positions changed.
+// The garment data model: positions SoA plus polygon faces, polylines (`l`) and points (`p`) in CSR form, in
+// the file's own units (nothing converts them). Faces may be of any size and non-manifold; vertices may be used
+// by nothing. `source` keeps the original file text so a writer can give the file back line for line with only
+// the positions changed. A plain value: read it from any number of threads, change it from one.
 #include <refit/core/types.hpp>
 
 #include <memory>

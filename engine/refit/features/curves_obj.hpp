@@ -1,5 +1,5 @@
 #pragma once
-// Feature curves as OBJ polylines for inspection (`--curves-out`, `refit features`).
+// Feature curves as OBJ polylines for inspection (`--curves-out`, `refit features`), in the garment's units.
 #include <refit/features/feature_curves.hpp>
 #include <refit/features/shape_matching.hpp>
 

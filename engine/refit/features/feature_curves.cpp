@@ -175,6 +175,15 @@ FeatureCurve build_boundary(const FeatureGarment& g, const FeatureSpec& s, doubl
 
 }  // namespace
 
+Points all_samples(const std::vector<FeatureCurve>& curves) {
+  Points out(0, 3);
+  for (const FeatureCurve& c : curves) {  // a few curves of a few hundred samples
+    out.conservativeResize(out.rows() + c.samples.rows(), 3);
+    out.bottomRows(c.samples.rows()) = c.samples;
+  }
+  return out;
+}
+
 double FeatureCurve::spacing() const {
   const std::size_t m = size();
   if (m < 2) return 0.0;

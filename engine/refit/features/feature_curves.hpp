@@ -1,6 +1,6 @@
 #pragma once
-// From feature specifications to sampled feature curves on the ORIGINAL garment
-// (paper section 4.2, Fig. 3(d)), with the auxiliary points of section 4.3.
+// From feature specifications to sampled feature curves on the ORIGINAL garment (paper section 4.2, Fig. 3(d)),
+// with the auxiliary points of section 4.3. Lengths in the garment's units; plain functions of their arguments.
 #include <refit/core/garment.hpp>
 #include <refit/features/feature_file.hpp>
 #include <refit/features/plane.hpp>
@@ -28,6 +28,10 @@ struct FeatureCurve {
   /// Mean distance between consecutive samples.
   double spacing() const;
 };
+
+/// Every curve's samples, one curve after another: the order in which a
+/// binding numbers the samples of all curves.
+Points all_samples(const std::vector<FeatureCurve>& curves);
 
 struct FeatureCurveOptions {
   std::size_t aux_per_sample = 4;

@@ -31,7 +31,7 @@
 //    is fixed where the earlier curve's optimised polyline put the crossing (the
 //    new plane is moved along its normal to pass through those points); each
 //    curve is solved in 2D in its plane.
-// Closed curves wrap their indices; open curves drop the end terms.
+// Closed curves wrap their indices; open curves drop the end terms. Lengths in garment units; body callbacks run in parallel.
 #include <refit/body/centre_tree.hpp>
 #include <refit/features/bspline.hpp>
 #include <refit/features/feature_curves.hpp>

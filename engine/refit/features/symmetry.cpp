@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace refit {
 namespace {
@@ -117,6 +118,12 @@ std::vector<Index> mirror_pairs(const Points& samples, double c, double toleranc
     if (std::sqrt(d2) <= tolerance) pairs[static_cast<std::size_t>(i)] = j;
   }
   return pairs;
+}
+
+std::vector<Index> sample_mirror_pairs(const std::vector<FeatureCurve>& curves, double c) {
+  double spacing = std::numeric_limits<double>::infinity();
+  for (const FeatureCurve& curve : curves) spacing = std::min(spacing, curve.spacing());
+  return mirror_pairs(all_samples(curves), c, 0.5 * spacing);
 }
 
 void symmetrise(Points& points, const std::vector<Index>& pairs, double c) {

@@ -3,7 +3,7 @@
 // item 2). When the pair is mirror-symmetric, every feature curve acts on its
 // mirror image too: a curve whose mirror is not already a feature (the left
 // profile, but not a front profile lying on the plane) gets a mirrored copy, so
-// the feature and surface steps treat both sides alike.
+// the feature and surface steps treat both sides alike. Lengths in the garment's units; plain functions.
 #include <refit/features/feature_curves.hpp>
 #include <refit/features/shape_matching.hpp>
 
@@ -50,6 +50,10 @@ std::vector<FeatureCurve> add_mirrored_curves(std::vector<FeatureCurve> curves, 
 /// sample nearest its mirror about x = c, or -1 when none is within `tolerance`.
 inline constexpr Index kNoMirror = static_cast<Index>(-1);
 std::vector<Index> mirror_pairs(const Points& samples, double c, double tolerance);
+/// mirror_pairs of all_samples(curves) within half the finest curve's spacing:
+/// pairs only where the mirror image is a sample (a mirrored copy, a hem, a
+/// profile on the plane).
+std::vector<Index> sample_mirror_pairs(const std::vector<FeatureCurve>& curves, double c);
 
 /// Makes `points` (rows matching mirror_pairs' samples) mirror-symmetric: each
 /// paired row becomes the mean of itself and its partner's mirror image.

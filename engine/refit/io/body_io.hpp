@@ -2,7 +2,7 @@
 // Body meshes from files: OBJ with the engine's own parser, PLY, OFF and STL
 // with small readers of our own (mesh_formats.hpp). Polygons are fan-split
 // (a-b-c, a-c-d, ...) the same way for every format, so two bodies with the same
-// faces get the same triangles.
+// faces get the same triangles. Vertices stay in the file's units; a bad file is refit::Error naming it.
 #include <refit/body/body_mesh.hpp>
 
 #include <string>

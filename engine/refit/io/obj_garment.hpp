@@ -3,7 +3,7 @@
 // of any size, `l` polylines, `p` points, UVs, normals, groups, materials,
 // vertex colours, unknown statements) and a writer that gives the file back line
 // for line with only the positions (and the normals that follow from them)
-// changed.
+// changed. Positions stay in the file's units; both run in parallel inside. Bad input: refit::Error naming file and line.
 #include <refit/core/garment.hpp>
 #include <refit/io/file_bytes.hpp>
 

@@ -3,7 +3,9 @@
 // vertices inside body B, surface sanity, and for feature curves their shape
 // error, turning-angle change and profile straightness. Used by the pipeline's
 // report and by `refit compare`, which scores any result with the same vertex
-// order (Refit's or another tool's).
+// order (Refit's or another tool's). Lengths in the garment's units (the 1 cm
+// fit band converted by the caller); plain functions of their arguments,
+// parallel inside, the same figures for any thread count.
 #include <refit/body/body_mesh.hpp>
 #include <refit/body/body_surface.hpp>
 #include <refit/attach/attachment.hpp>

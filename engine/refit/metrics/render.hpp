@@ -2,7 +2,7 @@
 // Headless pictures of a resize: Embree ray casting with an orthographic camera
 // framing the body, plain Lambert shading with a headlight (folds and profiles
 // show), the body and one or two garments side by side, feature curves drawn on
-// top. PNG through stb_image_write.
+// top. PNG through stb_image_write. Sizes in pixels; the meshes in any one unit (the camera frames the body).
 #include <refit/body/body_mesh.hpp>
 #include <refit/core/garment.hpp>
 

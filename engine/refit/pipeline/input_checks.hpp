@@ -3,6 +3,8 @@
 // garment in cm on bodies in mm moved 78 cm with exit 0, a body B collapsed to a
 // point 81 cm; these are refused from the extents alone, with the likely fix.
 // Memory: a run is estimated from its sizes before anything large is allocated.
+// Lengths in the garment's units (`units_per_cm` converts the limits, given in
+// cm); plain functions of their arguments, safe to call from any thread.
 #include <refit/body/body_mesh.hpp>
 #include <refit/core/garment.hpp>
 

@@ -3,7 +3,6 @@
 #include <refit/features/curve_metrics.hpp>
 #include <refit/features/feature_curves.hpp>
 #include <refit/collision/collision.hpp>
-#include <refit/collision/distance_hold.hpp>
 #include <refit/io/obj_garment.hpp>
 #include <refit/metrics/metrics.hpp>
 #include <refit/pipeline/resize.hpp>
@@ -12,7 +11,6 @@
 #include <refit/pipeline/units.hpp>
 
 #include <cstdio>
-#include <limits>
 #include <optional>
 
 namespace refit {
@@ -28,6 +26,20 @@ std::vector<std::uint8_t> feature_corners(const SurfaceAttachment& attachment, E
   return corner;
 }
 
+// What a feature sample needs to clear body B: the collision step's rule, out
+// along the closest-point direction (inside: to the surface and the clearance beyond).
+ClearanceNeed clearance_need(const BodySurface& body, const Vec3& p, double clearance) {
+  ClearanceNeed need;
+  const bool in = body.inside(p);
+  const ClosestPoint cp = in ? body.closest(p) : body.closest_within(p, clearance);
+  if (!in && !(cp.distance < clearance)) return need;
+  const Vec3 towards = cp.point - p;
+  const double len = towards.norm();
+  need.direction = len > 1e-12 * (1.0 + p.norm()) ? Vec3((in ? towards : -towards) / len) : cp.normal;
+  need.amount = in ? len + clearance : clearance - len;
+  return need;
+}
+
 }  // namespace
 
 nlohmann::json garment_summary(const Garment& g) {
@@ -35,6 +47,15 @@ nlohmann::json garment_summary(const Garment& g) {
           {"faces", g.faces.rows()},
           {"lines", g.lines.rows()},
           {"points", g.points.rows()}};
+}
+
+SurfaceOptions surface_options_in_units(const ResizeOptions& options) {
+  const double per_cm = units_per_cm(options.units);
+  SurfaceOptions so = options.surface;
+  so.epsilon *= per_cm;
+  so.voxel *= per_cm;
+  so.clearance = 2.0 * options.clearance_cm * per_cm;
+  return so;
 }
 
 GarmentBinding::~GarmentBinding() = default;
@@ -98,29 +119,14 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
     // the collision step finds nothing to move on them (issue 13: the written garment follows the curves).
     if (options_.collision && sm.clearance <= 0.0) sm.clearance = (options_.clearance_cm + kFeatureClearanceMarginCm) * per_cm;
     features_ = bind_features(body_a_, std::move(curves), sm);
-    if (sym.symmetric) {
-      // Pairs only where the mirror image is a sample (the mirrored copies, a hem, a profile on the plane).
-      double spacing = std::numeric_limits<double>::infinity();
-      std::vector<const Points*> samples;
-      for (const FeatureCurve& c : features_->model.curves) {
-        samples.push_back(&c.samples);
-        spacing = std::min(spacing, c.spacing());
-      }
-      feature_mirror_ = mirror_pairs(concat_rows(samples), mirror_x_, 0.5 * spacing);
-    }
+    if (sym.symmetric) feature_mirror_ = sample_mirror_pairs(features_->model.curves, mirror_x_);
     bind_report_["features"] = clock.ms();
   }
   if (options_.stage == Stage::Full) {
     clock.reset();
     progress.stage("building the agent system");
-    SurfaceOptions so = options_.surface;
-    so.epsilon *= per_cm;
-    so.voxel *= per_cm;
-    so.clearance = 2.0 * options_.clearance_cm * per_cm;
-    std::vector<const Points*> samples;
-    if (features_)
-      for (const FeatureCurve& c : features_->model.curves) samples.push_back(&c.samples);
-    const Points all = concat_rows(samples);
+    const SurfaceOptions so = surface_options_in_units(options_);
+    const Points all = features_ ? all_samples(features_->model.curves) : Points(0, 3);
     // One pass over the garment for every curve's samples; the surface binding
     // and the report's shape_error_output share it.
     if (all.rows() > 0) feature_attachment_ = locate().attach(all);
@@ -129,8 +135,6 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
     } catch (const Error& e) {  // e.g. a voxel size too small for the garment: name its file
       throw input_error(garment_->source ? garment_->source->file : "garment", e.what());
     }
-    if (options_.collision && options_.hold_distance)
-      near_body_a_ = near_body_distances(garment_->positions, BodySurface(body_a_.mesh()), options_.hold_band_cm * per_cm);
     bind_report_["surface"] = clock.ms();
   }
 }
@@ -138,8 +142,7 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
 // What a run will need, from the sizes alone (issue 17): refused before the work
 // when above the budget or this machine's memory, and given in the report.
 void GarmentBinding::check_memory_estimate() {
-  SurfaceOptions so = options_.surface;
-  so.voxel *= units_per_cm(options_.units);
+  const SurfaceOptions so = surface_options_in_units(options_);
   double agents = 0.0;
   try {
     if (options_.stage == Stage::Full) agents = estimated_agent_count(*garment_, so);
@@ -161,158 +164,149 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
   check_body(body_b);
   check_same_connectivity(body_a_.mesh(), body_b);
   ResizeResult result;
-  nlohmann::json& report = result.report;
-  report["memory_estimate_mb"] = memory_estimate_mb_;
-  nlohmann::json& timings = report["timings_ms"];
-  Stopwatch clock;
+  result.report["memory_estimate_mb"] = memory_estimate_mb_;
 
   // Step 1: primary resizing (section 3).
-  progress.stage("warping to " + body_b.name);
-  const TriangleFrames frames_b = compute_frames(body_b);
-  check_body_b_scale(body_a_.mesh(), body_b, frames_b);
-  result.warped = warp_.apply(frames_b);
-  timings["warp"] = clock.ms();
-  report["warp"] = {{"alpha", options_.warp.alpha},
-                    {"max_triangles", options_.warp.max_triangles},
-                    {"capped_vertices", warp_.capped},
-                    {"degenerate_triangles_a", body_a_.frames().degenerate},
-                    {"degenerate_triangles_b", frames_b.degenerate}};
-  if (body_a_.frames().degenerate + frames_b.degenerate > 0)
-    result.warnings.push_back(std::to_string(body_a_.frames().degenerate) + " degenerate triangles on body A and " +
-                              std::to_string(frames_b.degenerate) + " on body B were skipped");
-  if (!result.warped.allFinite()) throw Error("internal: the warp produced a non-finite position");
-  result.positions = result.warped;
+  const TriangleFrames frames_b = warp_step(body_b, result, progress);
   if (options_.stage == Stage::Warp) return result;
   // Body B is body A wherever the garment is bound, so the warp kept every vertex
   // to the bit: the garment as given is the answer. The later steps only correct
   // what the warp changes, and the collision step moves nothing the input on A
   // had as it is (docs/method.md, "Identity").
   if ((result.warped.array() == garment_->positions.array()).all()) {
-    report["unchanged"] = true;
+    result.report["unchanged"] = true;
     return result;
   }
 
-  clock.reset();
+  const Stopwatch features_clock;  // the feature step's time counts body B's surface
   const BodySurface surface_b(body_b);
-  const auto distance_b = [&](const Vec3& p) { return surface_b.closest(p).distance; };
-  // What a feature sample needs to clear body B (the collision step's rule: out along the closest-point direction).
-  const auto clearance_b = [&](const Vec3& p, double clearance) {
-    ClearanceNeed need;
-    const bool in = surface_b.inside(p);
-    const ClosestPoint cp = in ? surface_b.closest(p) : surface_b.closest_within(p, clearance);
-    if (!in && !(cp.distance < clearance)) return need;
-    const Vec3 towards = cp.point - p;
-    const double len = towards.norm();
-    need.direction = len > 1e-12 * (1.0 + p.norm()) ? Vec3((in ? towards : -towards) / len) : cp.normal;
-    need.amount = in ? len + clearance : clearance - len;
-    return need;
-  };
-
+  const bool symmetric_b = body_b_symmetric(body_b, result.report);
   // Step 2: feature curves keep their shape (section 4).
-  // Symmetrise only when body B is symmetric too (the same vertices as body A's, mirrored).
-  bool symmetric_b = false;
-  report["symmetry"] = symmetry_report_;
-  if (!body_mirror_.empty()) {
-    const double body_b_error = paired_mirror_error(body_b.vertices, body_mirror_, mirror_x_);
-    symmetric_b = body_b_error <= mirror_tolerance_;
-    report["symmetry"]["body_b_error"] = body_b_error;
-    report["symmetry"]["symmetrised"] = symmetric_b;
-  }
-
-  // A symmetric pair gives a symmetric garment: each paired vertex halfway to its partner's mirror image.
-  const auto symmetrise = [&](Points& positions) {
-    const Points mirrored = mirror_x(carry(garment_mirror_, positions), mirror_x_);
-    for (Index i = 0; i < positions.rows(); ++i)
-      if (garment_paired_[i]) positions.row(i) = 0.5 * (positions.row(i) + mirrored.row(i));
-  };
-
-  FeatureResult& curves = result.features;
-  if (features_) {
-    progress.stage("optimising " + std::to_string(features_->model.curves.size()) + " feature curves");
-    if (features_->model.options.clearance > 0.0) surface_b.prepare_inside_test();
-    curves = optimise_features(*features_, frames_b, distance_b, clearance_b);
-    if (symmetric_b && !feature_mirror_.empty()) {
-      symmetrise_curves(curves, feature_mirror_, mirror_x_);
-      restore_meetings(features_->model, curves);
-    }
-    timings["features"] = clock.ms();
-    report["features"] = features_report(curves);
-  }
-
+  if (features_) feature_step(frames_b, surface_b, symmetric_b, features_clock, result, progress);
   // Step 3: the surface follows the curves and keeps its local shape (section 5).
   Points feature_before_collision;
-  if (surface_) {
-    clock.reset();
-    progress.stage("optimising the surface (" + std::to_string(surface_->agent_count()) + " agents)");
-    std::vector<const Points*> targets, warped;
-    for (const CurveResult& c : curves.curves) {
-      targets.push_back(&c.optimised);
-      warped.push_back(&c.warped);
-    }
-    const Points feature_warped = concat_rows(warped);
-    SurfaceResult s = surface_->apply(result.warped, concat_rows(targets), surface_b, &feature_warped);
-    timings["surface"] = clock.ms();
-    report["surface"] = surface_report(s.stats);
-    result.positions = std::move(s.positions);
-    // The agents' solve is not exactly mirror-symmetric (its ordering and blends are not):
-    // a symmetric pair gives a symmetric garment.
-    if (symmetric_b) symmetrise(result.positions);
-    if (s.stats.anchored > 0)
-      result.warnings.push_back(std::to_string(s.stats.anchored) + " agents in " + std::to_string(s.stats.anchored_groups) +
-                                " groups with no fixed agent were anchored at their warped positions");
-    if (!s.stats.converged)
-      result.warnings.push_back("surface solve stopped after " + std::to_string(s.stats.iterations) +
-                                " iterations with update " + std::to_string(s.stats.final_update));
-
-    // Where the surface step leaves each feature, before the collision step moves it.
-    feature_before_collision = carry(feature_attachment_, result.positions);
-  }
+  if (surface_) feature_before_collision = surface_step(surface_b, symmetric_b, result, progress);
   if (!result.positions.allFinite()) throw Error("internal: the surface step produced a non-finite position");
-
   // Beyond the paper: nothing of the garment may end inside body B.
-  if (surface_ && options_.collision) {
-    clock.reset();
-    progress.stage("resolving penetrations");
-    CollisionOptions co;
-    const double per_cm = units_per_cm(options_.units);
-    co.clearance = options_.clearance_cm * per_cm;
-    co.near_band *= per_cm;  // the defaults are in cm
-    co.max_lift *= per_cm;
-    co.face_clearance *= per_cm;
-    // The corners of the faces the curves sit on stay where the surface step put them (unless too close themselves).
-    std::vector<std::uint8_t> pinned;
-    if (!curves.curves.empty()) {
-      pinned = feature_corners(feature_attachment_, result.positions.rows());
-      co.pinned = &pinned;
-    }
-    if (!near_body_a_.empty()) {
-      DistanceHoldOptions ho;
-      ho.tolerance *= per_cm;  // the defaults are in cm
-      ho.reach *= per_cm;
-      if (!pinned.empty()) ho.pinned = &pinned;
-      report["distance_hold"] = hold_body_distance(*garment_, result.positions, surface_b, near_body_a_, ho).to_json();
-      // Where the body's closest point is not unique (a vertex on the spine's
-      // groove) the hold's direction picks one side.
-      if (symmetric_b) symmetrise(result.positions);
-    }
-    const CollisionReport c = resolve_penetrations(*garment_, result.positions, surface_b, co);
-    timings["collision"] = clock.ms();
-    report["collision"] = c.to_json();
-    if (c.inside_after > 0)
-      result.warnings.push_back(std::to_string(c.inside_after) + " vertices are still inside body B after collision resolution");
-  }
-  if (surface_ && !curves.curves.empty())
-    report_written_features(curves, carry(feature_attachment_, result.positions), carry(feature_attachment_, result.warped),
-                            feature_before_collision, report);
-  if (options_.metrics) {
-    clock.reset();
-    progress.stage("measuring");
-    const BodySurface surface_a(body_a_.mesh());
-    report["metrics"] = {{"warp", compute_metrics(*garment_, result.warped, surface_a, surface_b).to_json()},
-                         {"result", compute_metrics(*garment_, result.positions, surface_a, surface_b).to_json()}};
-    timings["metrics"] = clock.ms();
-  }
+  if (surface_ && options_.collision) collision_step(surface_b, result, progress);
+
+  if (surface_ && !result.features.curves.empty())
+    report_written_features(result.features, carry(feature_attachment_, result.positions),
+                            carry(feature_attachment_, result.warped), feature_before_collision, result.report);
+  if (options_.metrics) metrics_step(surface_b, result, progress);
   return result;
+}
+
+TriangleFrames GarmentBinding::warp_step(const BodyMesh& body_b, ResizeResult& result, const Progress& progress) const {
+  const Stopwatch clock;
+  progress.stage("warping to " + body_b.name);
+  TriangleFrames frames_b = compute_frames(body_b);
+  check_body_b_scale(body_a_.mesh(), body_b, frames_b);
+  result.warped = warp_.apply(frames_b);
+  result.report["timings_ms"]["warp"] = clock.ms();
+  result.report["warp"] = {{"alpha", options_.warp.alpha},
+                           {"max_triangles", options_.warp.max_triangles},
+                           {"capped_vertices", warp_.capped},
+                           {"degenerate_triangles_a", body_a_.frames().degenerate},
+                           {"degenerate_triangles_b", frames_b.degenerate}};
+  if (body_a_.frames().degenerate + frames_b.degenerate > 0)
+    result.warnings.push_back(std::to_string(body_a_.frames().degenerate) + " degenerate triangles on body A and " +
+                              std::to_string(frames_b.degenerate) + " on body B were skipped");
+  if (!result.warped.allFinite()) throw Error("internal: the warp produced a non-finite position");
+  result.positions = result.warped;
+  return frames_b;
+}
+
+// Symmetrise only when body B is symmetric too (the same vertices as body A's, mirrored).
+bool GarmentBinding::body_b_symmetric(const BodyMesh& body_b, nlohmann::json& report) const {
+  report["symmetry"] = symmetry_report_;
+  if (body_mirror_.empty()) return false;
+  const double body_b_error = paired_mirror_error(body_b.vertices, body_mirror_, mirror_x_);
+  const bool symmetric_b = body_b_error <= mirror_tolerance_;
+  report["symmetry"]["body_b_error"] = body_b_error;
+  report["symmetry"]["symmetrised"] = symmetric_b;
+  return symmetric_b;
+}
+
+// A symmetric pair gives a symmetric garment: each paired vertex halfway to its partner's mirror image.
+void GarmentBinding::symmetrise_garment(Points& positions) const {
+  const Points mirrored = mirror_x(carry(garment_mirror_, positions), mirror_x_);
+  for (Index i = 0; i < positions.rows(); ++i)
+    if (garment_paired_[i]) positions.row(i) = 0.5 * (positions.row(i) + mirrored.row(i));
+}
+
+void GarmentBinding::feature_step(const TriangleFrames& frames_b, const BodySurface& surface_b, bool symmetric_b,
+                                  const Stopwatch& clock, ResizeResult& result, const Progress& progress) const {
+  progress.stage("optimising " + std::to_string(features_->model.curves.size()) + " feature curves");
+  if (features_->model.options.clearance > 0.0) surface_b.prepare_inside_test();
+  FeatureResult& curves = result.features;
+  curves = optimise_features(
+      *features_, frames_b, [&](const Vec3& p) { return surface_b.closest(p).distance; },
+      [&](const Vec3& p, double clearance) { return clearance_need(surface_b, p, clearance); });
+  if (symmetric_b && !feature_mirror_.empty()) {
+    symmetrise_curves(curves, feature_mirror_, mirror_x_);
+    restore_meetings(features_->model, curves);
+  }
+  result.report["timings_ms"]["features"] = clock.ms();
+  result.report["features"] = features_report(curves);
+}
+
+Points GarmentBinding::surface_step(const BodySurface& surface_b, bool symmetric_b, ResizeResult& result,
+                                    const Progress& progress) const {
+  const Stopwatch clock;
+  progress.stage("optimising the surface (" + std::to_string(surface_->agent_count()) + " agents)");
+  std::vector<const Points*> targets, warped;
+  for (const CurveResult& c : result.features.curves) {
+    targets.push_back(&c.optimised);
+    warped.push_back(&c.warped);
+  }
+  const Points feature_warped = concat_rows(warped);
+  SurfaceResult s = surface_->apply(result.warped, concat_rows(targets), surface_b, &feature_warped);
+  result.report["timings_ms"]["surface"] = clock.ms();
+  result.report["surface"] = surface_report(s.stats);
+  result.positions = std::move(s.positions);
+  // The agents' solve is not exactly mirror-symmetric (its ordering and blends are not):
+  // a symmetric pair gives a symmetric garment.
+  if (symmetric_b) symmetrise_garment(result.positions);
+  if (s.stats.anchored > 0)
+    result.warnings.push_back(std::to_string(s.stats.anchored) + " agents in " + std::to_string(s.stats.anchored_groups) +
+                              " groups with no fixed agent were anchored at their warped positions");
+  if (!s.stats.converged)
+    result.warnings.push_back("surface solve stopped after " + std::to_string(s.stats.iterations) +
+                              " iterations with update " + std::to_string(s.stats.final_update));
+  // Where the surface step leaves each feature, before the collision step moves it.
+  return carry(feature_attachment_, result.positions);
+}
+
+void GarmentBinding::collision_step(const BodySurface& surface_b, ResizeResult& result, const Progress& progress) const {
+  const Stopwatch clock;
+  progress.stage("resolving penetrations");
+  CollisionOptions co;
+  const double per_cm = units_per_cm(options_.units);
+  co.clearance = options_.clearance_cm * per_cm;
+  co.near_band *= per_cm;  // the defaults are in cm
+  co.max_lift *= per_cm;
+  co.face_clearance *= per_cm;
+  // The corners of the faces the curves sit on stay where the surface step put them (unless too close themselves).
+  std::vector<std::uint8_t> pinned;
+  if (!result.features.curves.empty()) {
+    pinned = feature_corners(feature_attachment_, result.positions.rows());
+    co.pinned = &pinned;
+  }
+  const CollisionReport c = resolve_penetrations(*garment_, result.positions, surface_b, co);
+  result.report["timings_ms"]["collision"] = clock.ms();
+  result.report["collision"] = c.to_json();
+  if (c.inside_after > 0)
+    result.warnings.push_back(std::to_string(c.inside_after) + " vertices are still inside body B after collision resolution");
+}
+
+void GarmentBinding::metrics_step(const BodySurface& surface_b, ResizeResult& result, const Progress& progress) const {
+  const Stopwatch clock;
+  progress.stage("measuring");
+  const BodySurface surface_a(body_a_.mesh());
+  result.report["metrics"] = {{"warp", compute_metrics(*garment_, result.warped, surface_a, surface_b).to_json()},
+                              {"result", compute_metrics(*garment_, result.positions, surface_a, surface_b).to_json()}};
+  result.report["timings_ms"]["metrics"] = clock.ms();
 }
 
 }  // namespace refit

@@ -1,7 +1,14 @@
 #pragma once
 // The resize pipeline: the paper's three steps, read top to bottom in
-// GarmentBinding::resize. Bind once (garment + body A + features), apply to
-// any number of bodies B.
+// GarmentBinding::resize: the warp (section 3, eqs. 1-4), the feature curves
+// (section 4, eqs. 5-9), the surface (section 5, eqs. 10-15), then the collision
+// step and the report (beyond the paper). Bind once (garment + body A +
+// features), apply to any number of bodies B.
+// Units: positions in the garment's units (ResizeOptions::units); the physical
+// constants of ResizeOptions are in cm and converted. Threads: the binding is
+// read-only after construction and resize() is const; each step runs in
+// parallel inside (core/parallel.hpp), with bit-identical results for any
+// thread count. Bad input: refit::Error, its message naming the file.
 #include <refit/body/body_mesh.hpp>
 #include <refit/core/garment.hpp>
 #include <refit/core/progress.hpp>
@@ -21,6 +28,8 @@
 
 namespace refit {
 
+class BodySurface;
+
 /// How far a resize goes: the warp alone (step 1), warp + feature curves (steps
 /// 1-2: the garment is the warp, the curves are optimised), or all three steps.
 enum class Stage { Warp, Features, Full };
@@ -35,8 +44,6 @@ struct ResizeOptions {
   SurfaceOptions surface;      // epsilon and voxel in cm here; converted to garment units
   bool collision = true;       // push vertices inside body B out (beyond the paper)
   double clearance_cm = 0.2;   // ... to this distance outside the body
-  bool hold_distance = false;  // vertices near body A keep their distance on body B (with the collision step; off: docs/method.md)
-  double hold_band_cm = 1.25;  // ... those within this distance outside body A (beyond 1 cm: held, not dragged by held neighbours)
   bool metrics = false;        // add fit, penetration and sanity metrics (warp and result) to the report
   double memory_budget_mb = 0; // a run estimated above this is refused before the work (0: the machine's memory)
 };
@@ -70,6 +77,18 @@ class GarmentBinding {
 
  private:
   void check_memory_estimate();
+  // The steps of resize(), in the paper's order; each adds its part of the
+  // report, its time and its warnings to `result`.
+  TriangleFrames warp_step(const BodyMesh& body_b, ResizeResult& result, const Progress& progress) const;
+  bool body_b_symmetric(const BodyMesh& body_b, nlohmann::json& report) const;
+  void feature_step(const TriangleFrames& frames_b, const BodySurface& surface_b, bool symmetric_b,
+                    const Stopwatch& clock, ResizeResult& result, const Progress& progress) const;
+  Points surface_step(const BodySurface& surface_b, bool symmetric_b, ResizeResult& result,
+                      const Progress& progress) const;  // returns the features where the surface step leaves them
+  void collision_step(const BodySurface& surface_b, ResizeResult& result, const Progress& progress) const;
+  void metrics_step(const BodySurface& surface_b, ResizeResult& result, const Progress& progress) const;
+  void symmetrise_garment(Points& positions) const;
+
   std::shared_ptr<const Garment> garment_;
   ResizeOptions options_;
   nlohmann::json symmetry_report_;
@@ -82,11 +101,14 @@ class GarmentBinding {
   WarpBinding warp_;
   std::optional<FeatureBinding> features_;
   std::optional<SurfaceBinding> surface_;
-  std::vector<double> near_body_a_;  // per garment vertex: its distance to body A when held (distance_hold.hpp), else NaN
   SurfaceAttachment feature_attachment_;  // where the feature samples (all curves, in order) sit on the garment
   nlohmann::json bind_report_;
   double memory_estimate_mb_ = 0.0;
 };
+
+/// The surface step's options in garment units: `options.surface` keeps epsilon
+/// and voxel in cm, and the agents keep clear of body B by twice the collision clearance.
+SurfaceOptions surface_options_in_units(const ResizeOptions& options);
 
 /// The report's fixed part: garment counts.
 nlohmann::json garment_summary(const Garment& g);

@@ -17,6 +17,12 @@ Points concat_rows(const std::vector<const Points*>& parts) {
   return out;
 }
 
+nlohmann::json symmetry_report(const SymmetryCheck& sym) {
+  return {{"plane_x", sym.plane_x},          {"garment_error", sym.garment_error},
+          {"body_a_error", sym.body_error},  {"tolerance", sym.tolerance},
+          {"symmetric", sym.symmetric},      {"mirrored_features", nlohmann::json::array()}};
+}
+
 nlohmann::json surface_report(const SurfaceStats& s) {
   return {{"agents", s.agents},
           {"garment_agents", s.garment_agents},

@@ -1,7 +1,9 @@
 #pragma once
 // The parts of a resize report that the in-memory pipeline (resize.cpp) and the
-// chunked one (refit/chunked) share, so both give the same report.
+// chunked one (refit/chunked) share, so both give the same report. Lengths in
+// the garment's units, times in ms; plain functions of their arguments.
 #include <refit/features/shape_matching.hpp>
+#include <refit/features/symmetry.hpp>
 #include <refit/surface/surface.hpp>
 
 #include <nlohmann/json.hpp>
@@ -12,6 +14,10 @@ namespace refit {
 
 /// The rows of `parts`, one after another.
 Points concat_rows(const std::vector<const Points*>& parts);
+
+/// The report's "symmetry" object as the binding finds it (body B's figures
+/// and the mirrored curves' names are added later).
+nlohmann::json symmetry_report(const SymmetryCheck& sym);
 
 /// The report's "surface" object.
 nlohmann::json surface_report(const SurfaceStats& s);

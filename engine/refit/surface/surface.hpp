@@ -9,6 +9,11 @@
 // normal orientation, and each vertex's agents within reach. Apply many
 // (SurfaceBinding::apply, per body B): the constraints (eqs. 14-15), the
 // Gauss-Seidel solve of eq. 13 and the reconstruction (eq. 4 blending).
+//
+// Units: the garment's (SurfaceOptions' epsilon, voxel and clearance too; the
+// pipeline converts them from cm). Threads: the binding is read-only after
+// bind and apply() is const; the solve runs in parallel inside, with
+// bit-identical results for any thread count.
 #include <refit/attach/attachment.hpp>
 #include <refit/core/garment.hpp>
 #include <refit/surface/agent_frames.hpp>

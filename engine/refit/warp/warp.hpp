@@ -1,6 +1,6 @@
 #pragma once
-// Step 1, primary resizing (paper section 3, eqs. 1-4, read with DESIGN.md).
-//
+// Step 1, primary resizing (paper section 3, eqs. 1-4, read with DESIGN.md). Lengths in the garment's units;
+// a binding is read-only once made, and apply() runs in parallel with the same bits for any thread count.
 // Bind once: for every point p, the nearest triangle centre q on body A, the
 // triangles whose centre lies within (1+alpha)|pq| (eq. 2, capped to the
 // `max_triangles` nearest of them), and p's local coordinates in each triangle's
