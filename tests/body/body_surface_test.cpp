@@ -15,6 +15,7 @@
 #define REFIT_HAVE_MANNEQUIN 1
 #endif
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -265,6 +266,41 @@ TEST(BodySurface, MakeHumanBodyAgainstBruteForce) {
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   std::printf("BodySurface of %zu triangles built in %.1f ms\n", m.triangles.size(), ms);
   check_against_brute_force(m, 1500, 5);
+}
+
+TEST(BodySurface, ClosestAndInsideAnswersAsInsideThenClosest) {
+  // Points from deep inside to far outside a real body (and its grid's inside,
+  // outside and boundary cells): the one-query answer is the two-query one, exactly.
+  const std::string dir = test::shared_data_dir();
+  if (dir.empty()) GTEST_SKIP() << "shared data (../shared/data) not found";
+  const BodyMesh m = load_obj_body(dir + "/bodies/F_heavier.obj");
+  const BodySurface s(m);
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<std::size_t> pick(0, m.vertices.rows() - 1);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::size_t inside = 0, outside_near = 0, outside_none = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const Vec3 dir3 = Vec3(unit(rng), unit(rng), unit(rng)).normalized();
+    const double offset = std::array<double, 6>{0.01, 0.1, 0.3, 1.0, 3.0, 8.0}[std::size_t(i) % 6];
+    const Vec3 p = row3(m.vertices, Index(pick(rng))) + offset * dir3;
+    for (double radius : {0.2, 1.0}) {
+      const SignedClosestPoint both = s.closest_and_inside(p, radius);
+      const bool in = s.inside(p);
+      const ClosestPoint cp = in ? s.closest(p) : s.closest_within(p, radius);
+      ASSERT_EQ(both.inside, in) << i;
+      ASSERT_EQ(both.distance, cp.distance) << i;
+      if (std::isfinite(cp.distance)) {
+        ASSERT_EQ(both.triangle, cp.triangle) << i;
+        ASSERT_TRUE(both.point == cp.point) << i;
+      }
+      inside += in;
+      outside_near += !in && std::isfinite(cp.distance);
+      outside_none += !in && !std::isfinite(cp.distance);
+    }
+  }
+  EXPECT_GT(inside, 500u);
+  EXPECT_GT(outside_near, 500u);
+  EXPECT_GT(outside_none, 500u);
 }
 
 }  // namespace

@@ -536,6 +536,34 @@ bool BodySurface::inside(const Vec3& p) const {
   return impl_->inside_given(impl_->query(p, impl_->near_tolerance));
 }
 
+SignedClosestPoint BodySurface::closest_and_inside(const Vec3& p, double max_distance) const {
+  SignedClosestPoint r;
+  if (!p.allFinite()) {
+    r.distance = kInf;
+    return r;
+  }
+  const std::uint8_t g = impl_->grid_label(p);
+  if (g == Impl::kInside) {
+    static_cast<ClosestPoint&>(r) = closest(p);
+    r.inside = true;
+    return r;
+  }
+  if (g == Impl::kOutside) {
+    static_cast<ClosestPoint&>(r) = closest_within(p, max_distance);
+    return r;
+  }
+  // inside() queries as far as near_tolerance; one query as far as both need
+  // finds the same closest point (ties go to the lowest triangle either way).
+  PointQueryData d = impl_->query(p, std::max(max_distance, impl_->near_tolerance));
+  PointQueryData near = d;
+  if (near.best_d2 > impl_->near_tolerance * impl_->near_tolerance) near.best_d2 = kInf;
+  r.inside = impl_->inside_given(near);
+  if (r.inside && !std::isfinite(d.best_d2)) d = impl_->query(p, kInf);
+  if (!r.inside && d.best_d2 > max_distance * max_distance) d.best_d2 = kInf;
+  static_cast<ClosestPoint&>(r) = closest_of(d, impl_->face_normal);
+  return r;
+}
+
 double BodySurface::signed_distance(const Vec3& p) const {
   if (!p.allFinite()) return std::numeric_limits<double>::quiet_NaN();
   const PointQueryData d = impl_->query(p, kInf);

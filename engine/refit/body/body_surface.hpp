@@ -37,6 +37,10 @@ class BodySurface {
   /// one point query answers both. Nothing within max_distance: distance = +inf
   /// and `inside` is not decided (prove the point outside or call inside()).
   SignedClosestPoint signed_closest_within(const Vec3& p, double max_distance) const;
+  /// inside() and, from the same point query where it can, the closest point:
+  /// within max_distance when p is outside (distance = +inf when none), anywhere
+  /// when inside. The same answers as inside() then closest() or closest_within().
+  SignedClosestPoint closest_and_inside(const Vec3& p, double max_distance) const;
   /// True when p is inside the closed body (ray parity, majority over several directions).
   bool inside(const Vec3& p) const;
   /// Builds the inside test's lookup grid now; otherwise the first inside() call

@@ -44,8 +44,8 @@ Constraint constraint_at(const Vec3& p, bool in, const ClosestPoint& cp, double 
 }
 
 Constraint check_vertex(const Vec3& p, const BodySurface& body, double clearance) {
-  const bool in = body.inside(p);
-  return constraint_at(p, in, in ? body.closest(p) : body.closest_within(p, clearance), clearance);
+  const SignedClosestPoint at = body.closest_and_inside(p, clearance);
+  return constraint_at(p, at.inside, at, clearance);
 }
 
 // Corner mean of face f.
@@ -75,13 +75,17 @@ constexpr double kFaceSamples[7][3] = {{1.0 / 3, 1.0 / 3, 1.0 / 3}, {0.5, 0.5, 0
 // outside body B by (0 when unknown). The open ball of that radius around the
 // corner is outside the body, so a point of the face well within it clears the
 // body without a query: on a dense garment most faces near the body need none.
+//
+// `need` null: only whether a point of the face is inside (clearance 0), which
+// needs no closest points and stops at the first inside point.
 bool face_needs(const Garment& g, const Points& positions, std::size_t f, const BodySurface& body, double clearance,
-                const std::vector<double>* outside_by, std::vector<Constraint>& need) {
+                const std::vector<double>* outside_by, std::vector<Constraint>* need) {
   const auto face = g.faces.row(f);
-  need.assign(face.size(), Constraint{});
+  if (need) need->assign(face.size(), Constraint{});
+  if (!need) clearance = 0.0;
   bool inside = false;
   auto ask = [&](std::size_t corner, const Constraint& c, double share) {
-    if (share > 0.0 && c.amount * share > need[corner].amount) need[corner] = {c.dir, c.amount * share, true, c.inside};
+    if (share > 0.0 && c.amount * share > (*need)[corner].amount) (*need)[corner] = {c.dir, c.amount * share, true, c.inside};
   };
   const Vec3 centre = face_centre(g, positions, f);
   double radius = 0.0;
@@ -98,11 +102,12 @@ bool face_needs(const Garment& g, const Points& positions, std::size_t f, const 
   // clears the body too.
   double clear_within = -1.0;
   if (!clear_by_a_corner(centre)) {
-    const bool centre_in = body.inside(centre);
-    const ClosestPoint at = centre_in ? body.closest(centre) : body.closest_within(centre, radius + clearance);
+    const SignedClosestPoint at = body.closest_and_inside(centre, radius + clearance);
+    const bool centre_in = at.inside;
+    if (centre_in && !need) return true;
     if (!centre_in && !(at.distance < radius + clearance)) return false;
     const Constraint at_centre = constraint_at(centre, centre_in, at, clearance);
-    if (at_centre.active) {
+    if (at_centre.active && need) {
       inside = at_centre.inside;
       for (std::size_t i = 0; i < face.size(); ++i) ask(i, at_centre, 1.0);
     }
@@ -114,6 +119,10 @@ bool face_needs(const Garment& g, const Points& positions, std::size_t f, const 
     for (const auto& w : kFaceSamples) {
       const Vec3 q = w[0] * a + w[1] * b + w[2] * c;
       if ((q - centre).norm() <= clear_within || clear_by_a_corner(q)) continue;
+      if (!need) {
+        if (body.inside(q)) return true;
+        continue;
+      }
       const Constraint s = check_vertex(q, body, clearance);
       if (!s.active) continue;
       inside = inside || s.inside;
@@ -128,8 +137,7 @@ bool face_needs(const Garment& g, const Points& positions, std::size_t f, const 
 
 bool face_inside(const Garment& g, const Points& positions, std::size_t f, const BodySurface& body) {
   if (g.faces.row_size(f) < 3) return false;
-  std::vector<Constraint> need;
-  return face_needs(g, positions, f, body, 0.0, nullptr, need);
+  return face_needs(g, positions, f, body, 0.0, nullptr, nullptr);
 }
 
 }  // namespace
@@ -151,7 +159,13 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   std::vector<long> slot(n, -1);
   // Per vertex, how far it is known to be outside body B (this round's check, or
   // an earlier one's for vertices not moved since): see face_needs.
-  std::vector<double> outside_by(n, 0.0);  // a region vertex's slot in this round's `region`, else -1
+  std::vector<double> outside_by(n, 0.0);
+  // Per vertex, its closest point on body B within `reach` as of its last check
+  // (distance +inf when none): a vertex is checked again whenever it moves, so
+  // the near-band cap below needs no query of its own.
+  const double reach = std::max(options.clearance, options.near_band);
+  std::vector<Vec3> near_point(n, Vec3::Zero());
+  std::vector<double> near_distance(n, std::numeric_limits<double>::infinity());
   std::vector<std::uint8_t> constrained(n, 0);  // this round's vertex constraints
   std::vector<std::uint8_t> finite(n, 0);
   parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
@@ -180,9 +194,11 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
           const Index i = round == 0 ? static_cast<Index>(k) : to_check[k];
           if (!finite[i]) continue;
           const Vec3 p = row3(positions, i);
-          const bool in = body_b.inside(p);
-          const ClosestPoint cp = in ? body_b.closest(p) : body_b.closest_within(p, options.clearance);
-          outside_by[i] = in ? 0.0 : std::min(cp.distance, options.clearance);
+          const SignedClosestPoint cp = body_b.closest_and_inside(p, reach);
+          const bool in = cp.inside;
+          outside_by[i] = in ? 0.0 : std::min(cp.distance, reach);
+          near_point[i] = cp.point;
+          near_distance[i] = cp.distance;
           const Constraint c = constraint_at(p, in, cp, options.clearance);
           if (c.active) found[blk].emplace_back(i, c);
         }
@@ -203,6 +219,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     const std::size_t nf = g.faces.rows();
     std::vector<std::vector<std::pair<Index, Constraint>>> face_found((nf + kBlock - 1) / kBlock);
     std::vector<std::size_t> faces_in(face_found.size(), 0);
+    const bool last_round = round + 1 >= std::max(1, options.max_rounds);
     parallel_for(0, face_found.size(), 1, [&](std::size_t b, std::size_t e) {
       std::vector<Constraint> need;
       for (std::size_t blk = b; blk < e; ++blk)
@@ -215,11 +232,14 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
             ok = ok && finite[v];
           }
           if (!check || !ok) continue;
-          const bool in = face_needs(g, positions, f, body_b, options.face_clearance, &outside_by, need);
+          // Only counted (not asked of) while a corner is constrained, so only inside or not is needed.
+          const bool waits =
+              !last_round && std::any_of(face.begin(), face.end(), [&](Index v) { return constrained[v] != 0; });
+          const bool in =
+              face_needs(g, positions, f, body_b, options.face_clearance, &outside_by, waits ? nullptr : &need);
           faces_in[blk] += in;
           if (round == 0) face_inside_before[f] = in;
-          const bool last_round = round + 1 >= std::max(1, options.max_rounds);
-          if (!last_round && std::any_of(face.begin(), face.end(), [&](Index v) { return constrained[v] != 0; })) continue;
+          if (waits) continue;
           for (std::size_t i = 0; i < face.size(); ++i)
             if (need[i].active) face_found[blk].emplace_back(face[i], need[i]);
         }
@@ -280,14 +300,19 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     std::vector<Vec3> disp(m, Vec3::Zero()), next(m);
     for (std::size_t k = 0; k < m; ++k) slot[region[k]] = static_cast<long>(k);
     auto slot_of = [&](Index v) -> long { return slot[v]; };
-    // Each region vertex's in-region neighbours, as slots of `region`.
-    std::vector<std::vector<long>> rows(m);
-    parallel_for(0, m, 256, [&](std::size_t b, std::size_t e) {
+    // Each region vertex's in-region neighbours, as slots of `region` (CSR).
+    std::vector<std::size_t> row_start(m + 1, 0);
+    parallel_for(0, m, 1024, [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k)
+        for (Index j : adj.row(region[k])) row_start[k + 1] += slot_of(j) >= 0;
+    });
+    for (std::size_t k = 0; k < m; ++k) row_start[k + 1] += row_start[k];
+    std::vector<std::size_t> row_slots(row_start[m]);
+    parallel_for(0, m, 1024, [&](std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e; ++k) {
-        for (Index j : adj.row(region[k])) {
-          const long s = slot_of(j);
-          if (s >= 0) rows[k].push_back(s);
-        }
+        std::size_t at = row_start[k];
+        for (Index j : adj.row(region[k]))
+          if (slot_of(j) >= 0) row_slots[at++] = std::size_t(slot_of(j));
       }
     });
     // The constraint of each region slot, if any (both lists ascending).
@@ -306,9 +331,8 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
       parallel_for(0, m, 256, [&](std::size_t b, std::size_t e) {
         for (std::size_t k = b; k < e; ++k) {
           const Vec3 p = row3(positions, region[k]);
-          const ClosestPoint cp = body_b.closest_within(p, options.near_band);
-          if (!(cp.distance < options.near_band)) continue;
-          const Vec3 away = p - cp.point;
+          if (!(near_distance[region[k]] < options.near_band)) continue;
+          const Vec3 away = p - near_point[region[k]];
           const double len = away.norm();
           if (con_at[k]) {
             cap_dir[k] = con_at[k]->dir;
@@ -340,7 +364,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
       parallel_for(0, m, 1024, [&](std::size_t b, std::size_t e) {
         for (std::size_t k = b; k < e; ++k) {
           Vec3 sum = disp[k];
-          for (long s : rows[k]) sum += disp[static_cast<std::size_t>(s)];
+          for (std::size_t r = row_start[k]; r < row_start[k + 1]; ++r) sum += disp[row_slots[r]];
           // Out-of-region neighbours contribute zero but still count.
           const double deg = 1.0 + static_cast<double>(adj.row_size(region[k]));
           next[k] = sum / deg;

@@ -33,25 +33,50 @@ Vec3 displaced_face_normal(const Garment& g, const Points& positions, std::size_
 // it had) gets each corner's displacement replaced by the mean over its
 // turned-over faces of their corners' mean displacement (a face whose corners
 // all move alike keeps its normal), for up to `passes` passes. Faces the
-// correction does not reach (no region corner) cannot turn.
+// correction does not reach (no region corner) cannot turn. After the first
+// pass only the faces around a changed corner are tested again: the others
+// keep their verdict.
 template <class SlotOf>
 void unfold(const Garment& g, const Points& positions, const std::vector<Index>& region, const SlotOf& slot_of,
             int passes, std::vector<Vec3>& disp) {
-  std::vector<Index> faces;  // faces with a corner in the region, ascending
-  for (std::size_t f = 0; f < g.faces.rows(); ++f) {
-    const auto face = g.faces.row(f);
-    if (face.size() >= 3 && std::any_of(face.begin(), face.end(), [&](Index v) { return slot_of(v) >= 0; }))
-      faces.push_back(Index(f));
-  }
+  // Faces with a corner in the region, ascending: each block lists its own, joined in order.
+  constexpr std::size_t kBlock = 4096;
+  const std::size_t nf = g.faces.rows();
+  std::vector<std::vector<Index>> found((nf + kBlock - 1) / kBlock);
+  parallel_for(0, found.size(), 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t blk = b; blk < e; ++blk)
+      for (std::size_t f = blk * kBlock; f < std::min(nf, (blk + 1) * kBlock); ++f) {
+        const auto face = g.faces.row(f);
+        if (face.size() >= 3 && std::any_of(face.begin(), face.end(), [&](Index v) { return slot_of(v) >= 0; }))
+          found[blk].push_back(Index(f));
+      }
+  });
+  std::vector<Index> faces;
+  for (const auto& list : found) faces.insert(faces.end(), list.begin(), list.end());
   std::vector<Vec3> before(faces.size());
   parallel_for(0, faces.size(), 256, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) before[i] = displaced_face_normal(g, positions, faces[i], slot_of, nullptr);
   });
-  std::vector<std::uint8_t> turned(faces.size());
+  // Per region slot, the positions in `faces` of its faces (CSR).
+  std::vector<std::size_t> start(region.size() + 1, 0);
+  for (Index f : faces)
+    for (Index v : g.faces.row(f))
+      if (slot_of(v) >= 0) ++start[std::size_t(slot_of(v)) + 1];
+  for (std::size_t k = 0; k < region.size(); ++k) start[k + 1] += start[k];
+  std::vector<std::size_t> face_at(start.back()), fill(start.begin(), start.end() - 1);
+  for (std::size_t i = 0; i < faces.size(); ++i)
+    for (Index v : g.faces.row(faces[i]))
+      if (slot_of(v) >= 0) face_at[fill[std::size_t(slot_of(v))]++] = i;
+
+  std::vector<std::uint8_t> turned(faces.size(), 0), dirty(faces.size(), 0);
+  std::vector<std::size_t> test(faces.size());  // the faces to test this pass, ascending
+  for (std::size_t i = 0; i < faces.size(); ++i) test[i] = i;
   for (int pass = 0; pass < passes; ++pass) {
-    parallel_for(0, faces.size(), 256, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i)
+    parallel_for(0, test.size(), 256, [&](std::size_t b, std::size_t e) {
+      for (std::size_t t = b; t < e; ++t) {
+        const std::size_t i = test[t];
         turned[i] = before[i].squaredNorm() > 0.0 && displaced_face_normal(g, positions, faces[i], slot_of, &disp).dot(before[i]) <= 0.0;
+      }
     });
     std::vector<Vec3> sum(region.size(), Vec3::Zero());
     std::vector<int> count(region.size(), 0);
@@ -74,8 +99,18 @@ void unfold(const Garment& g, const Points& positions, const std::vector<Index>&
       }
     }
     if (!any) return;
-    for (std::size_t k = 0; k < region.size(); ++k)
-      if (count[k] > 0) disp[k] = sum[k] / double(count[k]);
+    test.clear();
+    for (std::size_t k = 0; k < region.size(); ++k) {
+      if (count[k] == 0) continue;
+      const Vec3 d = sum[k] / double(count[k]);
+      if (d == disp[k]) continue;
+      disp[k] = d;
+      for (std::size_t a = start[k]; a < start[k + 1]; ++a)
+        if (!dirty[face_at[a]]) dirty[face_at[a]] = 1, test.push_back(face_at[a]);
+    }
+    if (test.empty()) return;  // nothing changed: the passes left would change nothing either
+    std::sort(test.begin(), test.end());
+    for (std::size_t i : test) dirty[i] = 0;
   }
 }
 
