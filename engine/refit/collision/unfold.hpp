@@ -1,5 +1,5 @@
 #pragma once
-// No folds: what the collision step and the distance hold share. A correction
+// No folds, for the collision step (collision.cpp): a correction
 // (a displacement per region vertex) that would turn a face over is evened out
 // over that face's corners until no face turns.
 #include <refit/core/garment.hpp>

@@ -175,7 +175,7 @@ FeatureCurve build_boundary(const FeatureGarment& g, const FeatureSpec& s, doubl
 
 }  // namespace
 
-Points all_samples(const std::vector<FeatureCurve>& curves) {
+Points all_samples(std::span<const FeatureCurve> curves) {
   Points out(0, 3);
   for (const FeatureCurve& c : curves) {  // a few curves of a few hundred samples
     out.conservativeResize(out.rows() + c.samples.rows(), 3);

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <functional>
 #include <utility>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -31,7 +32,7 @@ struct FeatureCurve {
 
 /// Every curve's samples, one curve after another: the order in which a
 /// binding numbers the samples of all curves.
-Points all_samples(const std::vector<FeatureCurve>& curves);
+Points all_samples(std::span<const FeatureCurve> curves);
 
 struct FeatureCurveOptions {
   std::size_t aux_per_sample = 4;

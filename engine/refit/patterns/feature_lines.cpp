@@ -51,17 +51,9 @@ std::vector<FeatureLine> bind_feature_lines(const Garment& original, const Panel
                                             std::span<const FeatureCurve> curves) {
   std::vector<FeatureLine> out;
   if (curves.empty() || original.faces.rows() == 0) return out;
-  Eigen::Index total = 0;
-  for (const FeatureCurve& c : curves) total += c.samples.rows();
-  Points samples(total, 3);
-  Eigen::Index row = 0;
-  for (const FeatureCurve& c : curves) {
-    samples.middleRows(row, c.samples.rows()) = c.samples;
-    row += c.samples.rows();
-  }
-  const SurfaceAttachment at = attach_points(original, samples);
+  const SurfaceAttachment at = attach_points(original, all_samples(curves));
   const FanLookup fans(original);
-  row = 0;
+  Eigen::Index row = 0;
   for (const FeatureCurve& c : curves) {
     std::vector<FeatureLine> runs;
     for (Eigen::Index i = 0; i < c.samples.rows(); ++i, ++row) {

@@ -103,9 +103,7 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
     for (std::size_t i = 0; i < mirror_distance.size(); ++i) garment_paired_[i] = mirror_distance[i] <= sym.tolerance;
     body_mirror_ = mirror_pairs(body_a_.mesh().vertices, mirror_x_, sym.tolerance);
   }
-  symmetry_report_ = {{"plane_x", sym.plane_x},          {"garment_error", sym.garment_error},
-                      {"body_a_error", sym.body_error},  {"tolerance", sym.tolerance},
-                      {"symmetric", sym.symmetric},      {"mirrored_features", nlohmann::json::array()}};
+  symmetry_report_ = symmetry_report(sym);
   bind_report_["symmetry"] = clock.ms();
   if (!features.empty()) {
     clock.reset();
