@@ -25,6 +25,9 @@ import subprocess
 import sys
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from dense import densified  # noqa: E402
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 
@@ -57,11 +60,7 @@ def main():
         print(f"skipped: the shared data is not at {a.data}")
         return 77
     os.makedirs(a.workdir, exist_ok=True)
-    garment = os.path.join(a.workdir, f"dress_{a.vertices}.obj")
-    if not os.path.exists(garment):
-        subprocess.run([sys.executable, os.path.join(a.data, "make_dense.py"),
-                        os.path.join(a.data, "garments", "dress_on_A_female.obj"), garment,
-                        "--min-vertices", str(a.vertices)], check=True, stdout=subprocess.DEVNULL)
+    garment = densified(a.data, "dress_on_A_female.obj", os.path.join(a.workdir, f"dress_{a.vertices}.obj"), a.vertices)
     body_a, body_b = (os.path.join(a.data, "bodies", b + ".obj") for b in ("A_female", "F_heavier"))
     features = os.path.join(HERE, "quality", "features", "dress.json")
     out_b, out_r = os.path.join(a.workdir, "blender_out.obj"), os.path.join(a.workdir, "refit_out.obj")

@@ -24,6 +24,9 @@ import subprocess
 import sys
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from dense import densified  # noqa: E402
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 
@@ -43,11 +46,8 @@ def main():
         print(f"skipped: the shared data is not at {a.data}")
         return 77
     os.makedirs(a.dense, exist_ok=True)
-    garment = os.path.join(a.dense, f"dress_{a.vertices}.obj")
-    if not os.path.exists(garment):
-        subprocess.run([sys.executable, os.path.join(a.data, "make_dense.py"),
-                        os.path.join(a.data, "garments", "dress_on_A_female.obj"), garment,
-                        "--min-vertices", str(a.vertices)], check=True)
+    garment = densified(a.data, "dress_on_A_female.obj", os.path.join(a.dense, f"dress_{a.vertices}.obj"), a.vertices,
+                        quiet=False)
     body = lambda name: os.path.join(a.data, "bodies", name + ".obj")
     base = [a.refit, "resize", "--garment", garment, "--from", body("A_female"), "--to", body("F_heavier"),
             "--features", os.path.join(HERE, "quality", "features", "dress.json"), "--threads", str(a.threads),

@@ -25,6 +25,9 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from dense import densified  # noqa: E402
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 REAL = {"dress": ("dress_on_A_female.obj", "dress.json"), "outfit": ("outfit_dress_jeans_on_A_female.obj",
                                                                    "outfit_dress_jeans.json")}
@@ -66,9 +69,7 @@ def main():
         f = os.path.join(work, f"{a.garment}_{n}.json")
         if a.garment != "procedural":
             f = os.path.join(HERE, "quality", "features", REAL[a.garment][1])
-            if not os.path.exists(g):
-                run([sys.executable, os.path.join(a.data, "make_dense.py"), os.path.join(a.data, "garments", REAL[a.garment][0]),
-                     g, "--min-vertices", str(n)])
+            densified(a.data, REAL[a.garment][0], g, n)
         elif not (os.path.exists(g) and os.path.exists(f)):  # a --workdir kept from an earlier run has them
             run([a.refit, "generate", "--vertices", str(n), "--garment-out", g, "--features-out", f])
         # Thread counts take turns run by run, so a slow spell of the shared
