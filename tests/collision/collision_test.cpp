@@ -132,6 +132,36 @@ TEST(Collision, PushedTopComesOutSmoothlyAndOnlyLocally) {
   EXPECT_TRUE(designed == p.garment.positions);
 }
 
+TEST(Collision, WhatTheSymmetrisationHookLeavesInsideIsPushedOutAgain) {
+  // The hook (the pipeline makes both sides of a symmetric pair move alike)
+  // puts the vertices the rounds moved on the right half back where they
+  // started, inside the body: the extra round pushes them out again.
+  Pushed p = pushed_top();
+  const BodySurface body(p.body);
+  CollisionOptions o;
+  int calls = 0;
+  std::size_t undone = 0;
+  o.symmetrise = [&](const Points& now) {
+    ++calls;
+    std::vector<std::pair<Index, Vec3>> moves;
+    for (Index i = 0; i < now.rows(); ++i)
+      if (p.pushed(i, 0) > 0.0 && row3(now, i) != row3(p.pushed, i) && body.inside(row3(p.pushed, i)))
+        moves.emplace_back(i, row3(p.pushed, i));
+    undone = moves.size();
+    return moves;
+  };
+  Points out = p.pushed;
+  const CollisionReport r = resolve_penetrations(p.garment, out, body, o);
+  EXPECT_EQ(calls, 1);
+  ASSERT_GT(undone, 20u) << "the hook must undo some pushes";
+  EXPECT_EQ(r.inside_after, 0u);
+  EXPECT_EQ(measure_penetration(out, body).inside, 0u);
+  EXPECT_EQ(r.faces_inside_after, count_face_centres_inside(p.garment, out, body));
+  Garment pushed_garment = p.garment;
+  pushed_garment.positions = p.pushed;
+  EXPECT_EQ(measure_sanity(pushed_garment, out).flipped_faces, 0u);
+}
+
 TEST(Collision, TheBodyPokingThroughACoarseFaceIsPushedOutToo) {
   // A flat 5 x 5 grid of 4 cm quads at y = 9.8 over a sphere of radius 10: the
   // corners nearest its top, (+-2, +-2), clear the body by about 0.2 (more than
@@ -222,7 +252,9 @@ TEST(Collision, SphereShellPartlyInsideComesOutBitIdenticalForAnyThreadCount) {
   EXPECT_EQ(measure_penetration(one, body).inside, 0u);
   EXPECT_EQ(measure_sanity(g, one).flipped_faces, 0u);
   for (Eigen::Index i = 0; i < one.rows(); ++i) EXPECT_GT(body.closest(row3(one, static_cast<Index>(i))).distance, 0.2 - 1e-9);
-  EXPECT_THROW(resolve_penetrations(g, shifted, body, CollisionOptions{-1.0}), Error);
+  CollisionOptions negative;
+  negative.clearance = -1.0;
+  EXPECT_THROW(resolve_penetrations(g, shifted, body, negative), Error);
 }
 
 }  // namespace

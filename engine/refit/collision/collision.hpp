@@ -12,6 +12,8 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
+#include <functional>
+#include <utility>
 #include <vector>
 
 namespace refit {
@@ -30,6 +32,11 @@ struct CollisionOptions {
   /// written garment keeps passing through the curves). A pinned vertex that is
   /// itself inside body B or too close still moves out.
   const std::vector<std::uint8_t>* pinned = nullptr;
+  /// Optional: after the rounds, new positions for some vertices (given the
+  /// positions then), e.g. both sides of a mirror-symmetric garment moved alike;
+  /// the rounds then run again over those vertices, so what it leaves too close
+  /// is pushed out by what it still needs.
+  std::function<std::vector<std::pair<Index, Vec3>>(const Points& positions)> symmetrise;
 };
 
 struct CollisionReport {
