@@ -98,7 +98,9 @@ Vec3 carry_one(const SurfaceAttachment& at, const Points& result, Index i) {
 
 Points carry(const SurfaceAttachment& at, const Points& result) {
   Points out(at.offset.rows(), 3);
-  for (Eigen::Index r = 0; r < out.rows(); ++r) out.row(r) = carry_one(at, result, Index(r)).transpose();
+  parallel_for(0, std::size_t(out.rows()), 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t r = b; r < e; ++r) out.row(Eigen::Index(r)) = carry_one(at, result, Index(r)).transpose();
+  });
   return out;
 }
 
