@@ -1,7 +1,8 @@
 // Issue 13 item 2 on real data: the MakeHuman skirt (mirror-symmetric about x = 0,
 // like every shared body) with a hem, a front and only a LEFT profile
 // (bench/quality/features/skirt.json). The left profile's mirror becomes a
-// feature, and the written garment is at most 0.1 cm less symmetric than the warp;
+// feature, and the written garment is at most 0.1 cm less symmetric than the warp
+// (here: at least twice as symmetric);
 // a lopsided body B is not forced into symmetry.
 // Skips when ../shared/data is absent.
 #include "support/test_support.hpp"
@@ -55,6 +56,9 @@ TEST(SymmetrySharedData, OneSidedProfileKeepsSkirtSymmetric) {
                 target, result, warp, r.report.at("surface").at("feature_gap").get<double>(),
                 r.report.at("surface").at("feature_gap_written").get<double>());
     EXPECT_LE(result, warp + 0.1) << target;
+    // The collision step moves both sides alike (GarmentBinding::symmetric_pushes):
+    // pushing each side by what it alone needed left 0.19 cm on F_heavier (warp 0.35).
+    EXPECT_LE(result, 0.5 * warp) << target;
     EXPECT_LE(r.report.at("surface").at("feature_gap").get<double>(), 0.05) << target;
     EXPECT_TRUE(sym.at("symmetrised").get<bool>()) << target;
   }

@@ -1,5 +1,6 @@
 #include <refit/body/body_surface.hpp>
 #include <refit/core/error.hpp>
+#include <refit/core/parallel.hpp>
 #include <refit/features/curve_metrics.hpp>
 #include <refit/features/feature_curves.hpp>
 #include <refit/collision/collision.hpp>
@@ -186,7 +187,7 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
   if (surface_) feature_before_collision = surface_step(surface_b, symmetric_b, result, progress);
   if (!result.positions.allFinite()) throw Error("internal: the surface step produced a non-finite position");
   // Beyond the paper: nothing of the garment may end inside body B.
-  if (surface_ && options_.collision) collision_step(surface_b, result, progress);
+  if (surface_ && options_.collision) collision_step(surface_b, symmetric_b, result, progress);
 
   if (surface_ && !result.features.curves.empty())
     report_written_features(result.features, carry(feature_attachment_, result.positions),
@@ -233,6 +234,42 @@ void GarmentBinding::symmetrise_garment(Points& positions) const {
     if (garment_paired_[i]) positions.row(i) = 0.5 * (positions.row(i) + mirrored.row(i));
 }
 
+// The collision step pushes each side by what it needs, and neither body B's
+// triangulation nor the garment's mesh is mirror-symmetric, so the two sides of
+// a symmetric pair come out pushed differently (the real dress on a shorter
+// body: mirror error 0.30 cm before the step, 0.41 after). Each paired vertex
+// whose push differs from its mirror image's (mirrored) by more than
+// `tolerance` takes the mean of the two, but moves at most `max_extra` beyond
+// its own push; the collision step then pushes out again whatever that leaves
+// too close. Measured with the quality suite, near-body change (median over all
+// near vertices / over those whose faces the input keeps clear of body A), from
+// 0.58 / 0.34 cm without this: the larger push for both sides 0.69 cm over all;
+// the plain mean 0.56 / 0.38; the capped mean (this) 0.56 / 0.34.
+std::vector<std::pair<Index, Vec3>> GarmentBinding::symmetric_pushes(const Points& before, const Points& after,
+                                                                    double tolerance, double max_extra) const {
+  Points mirrored = carry(garment_mirror_, after) - carry(garment_mirror_, before);  // the offsets cancel
+  mirrored.col(0) = -mirrored.col(0);
+  const std::size_t n = std::size_t(after.rows());
+  std::vector<std::uint8_t> moved(n, 0);
+  parallel_for(0, n, 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t v = b; v < e; ++v) {
+      const Index i = Index(v);
+      const Vec3 push = row3(after, i) - row3(before, i), other = row3(mirrored, i);
+      if (!garment_paired_[v] || !((other - push).norm() > tolerance)) continue;
+      Vec3 to = 0.5 * (push + other);
+      const Vec3 extra = to - push;
+      if (to.squaredNorm() > push.squaredNorm() && extra.norm() > max_extra)
+        to = push + (max_extra / extra.norm()) * extra;  // the side that needed less
+      mirrored.row(i) = (row3(before, i) + to).transpose();  // mirrored now holds the new position
+      moved[v] = 1;
+    }
+  });
+  std::vector<std::pair<Index, Vec3>> moves;
+  for (std::size_t v = 0; v < n; ++v)
+    if (moved[v]) moves.emplace_back(Index(v), row3(mirrored, Index(v)));
+  return moves;
+}
+
 void GarmentBinding::feature_step(const TriangleFrames& frames_b, const BodySurface& surface_b, bool symmetric_b,
                                   const Stopwatch& clock, ResizeResult& result, const Progress& progress) const {
   progress.stage("optimising " + std::to_string(features_->model.curves.size()) + " feature curves");
@@ -276,7 +313,8 @@ Points GarmentBinding::surface_step(const BodySurface& surface_b, bool symmetric
   return carry(feature_attachment_, result.positions);
 }
 
-void GarmentBinding::collision_step(const BodySurface& surface_b, ResizeResult& result, const Progress& progress) const {
+void GarmentBinding::collision_step(const BodySurface& surface_b, bool symmetric_b, ResizeResult& result,
+                                    const Progress& progress) const {
   const Stopwatch clock;
   progress.stage("resolving penetrations");
   CollisionOptions co;
@@ -291,6 +329,11 @@ void GarmentBinding::collision_step(const BodySurface& surface_b, ResizeResult& 
     pinned = feature_corners(feature_attachment_, result.positions.rows());
     co.pinned = &pinned;
   }
+  const Points before = symmetric_b ? result.positions : Points();
+  if (symmetric_b)
+    co.symmetrise = [&](const Points& now) {
+      return symmetric_pushes(before, now, kSymmetricPushToleranceCm * per_cm, co.max_lift);
+    };
   const CollisionReport c = resolve_penetrations(*garment_, result.positions, surface_b, co);
   result.report["timings_ms"]["collision"] = clock.ms();
   result.report["collision"] = c.to_json();

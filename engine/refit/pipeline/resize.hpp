@@ -24,6 +24,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace refit {
@@ -85,7 +86,10 @@ class GarmentBinding {
                     const Stopwatch& clock, ResizeResult& result, const Progress& progress) const;
   Points surface_step(const BodySurface& surface_b, bool symmetric_b, ResizeResult& result,
                       const Progress& progress) const;  // returns the features where the surface step leaves them
-  void collision_step(const BodySurface& surface_b, ResizeResult& result, const Progress& progress) const;
+  void collision_step(const BodySurface& surface_b, bool symmetric_b, ResizeResult& result,
+                      const Progress& progress) const;
+  std::vector<std::pair<Index, Vec3>> symmetric_pushes(const Points& before, const Points& after, double tolerance,
+                                                      double max_extra) const;
   void metrics_step(const BodySurface& surface_b, ResizeResult& result, const Progress& progress) const;
   void symmetrise_garment(Points& positions) const;
 
@@ -118,5 +122,7 @@ inline constexpr const char* kVersion = "0.1.0";
 /// With the collision step on, the joint feature solve keeps the curves this much
 /// farther from body B than the collision clearance (ShapeMatchingOptions::clearance 0).
 inline constexpr double kFeatureClearanceMarginCm = 0.05;
+/// The collision step's pushes of a symmetric pair are made alike when they differ by more than this.
+inline constexpr double kSymmetricPushToleranceCm = 0.02;
 
 }  // namespace refit
