@@ -157,6 +157,7 @@ struct Run {
         r["output"] = out;
         r["units"] = a.units;
         r["peak_memory_mb"] = peak_memory_mb();
+        r["huge_pages"] = huge_pages_requested();
         r["warnings"] = result.warnings;
         reports.push_back(r);
         body_outputs.commit();

@@ -27,4 +27,8 @@ struct Register {
   }
 };
 
+/// Whether this process runs with glibc's malloc asked for transparent huge
+/// pages (main.cpp sets it up; the report's `huge_pages`).
+bool huge_pages_requested();
+
 }  // namespace refit::cli
