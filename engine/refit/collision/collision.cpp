@@ -182,232 +182,227 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   body_b.prepare_inside_test();
   const Csr adj = vertex_adjacency(g);
 
-  // Two passes at most: the rounds, then (with options.symmetrise) one more round
-  // over what the symmetrisation changed. One: on the real garments of the
-  // quality suite 1, 2 or 5 give the same figures, and on the 1M dress the
-  // step took 2.7 s with 1 and 3.2 s with 5.
-  const int max_rounds = std::max(1, options.max_rounds);
-  int first_round = 0;  // rounds run before this pass
-  for (bool again = false;; again = true) {
-    const int rounds = again ? 1 : max_rounds;
-    for (int round = 0; round < rounds; ++round) {
-      const bool all = !again && round == 0;  // the first round checks every vertex and face
-      // 1. Which vertices are inside or too close, and where they must go: fixed
-      // blocks, each listing its constrained vertices, joined in block order.
-      const std::size_t count = all ? n : to_check.size();
-      constexpr std::size_t kBlock = kGrain / 4;
-      std::vector<std::vector<std::pair<Index, Constraint>>> found((count + kBlock - 1) / kBlock);
-      parallel_for(0, found.size(), 1, [&](std::size_t b, std::size_t e) {
-        for (std::size_t blk = b; blk < e; ++blk)
-          for (std::size_t k = blk * kBlock; k < std::min(count, (blk + 1) * kBlock); ++k) {
-            const Index i = all ? static_cast<Index>(k) : to_check[k];
-            if (!finite[i]) continue;
-            const Vec3 p = row3(positions, i);
-            const SignedClosestPoint cp = body_b.closest_and_inside(p, reach);
-            const bool in = cp.inside;
-            outside_by[i] = in ? 0.0 : std::min(cp.distance, reach);
-            near_point[i] = cp.point;
-            near_distance[i] = cp.distance;
-            const Constraint c = constraint_at(p, in, cp, options.clearance);
-            if (c.active) found[blk].emplace_back(i, c);
-          }
-      });
-      // Faces too: a coarse face whose corners all clear the body can still have
-      // the body poking through its middle (the real dress's bust: 115 face centres
-      // inside body B, none of its corners). A face whose centre is inside or too
-      // close gives each corner its centre's constraint (moving all corners by it
-      // moves the centre by it); a corner with several keeps the largest.
-      // A face with a constrained corner waits for the next round: that corner's own
-      // move usually clears it, and asking its other corners now as well lifted
-      // vertices that sat on the body (the real jeans: 0.13 cm off body A, 0.81 off B).
-      for (const auto& list : found)
-        for (const auto& ic : list) constrained[ic.first] = 1;
-      std::vector<std::uint8_t> check_face_of(all ? 0 : n, 0);
-      if (all) face_inside_before.assign(g.faces.rows(), 0);
-      for (std::size_t k = 0; !all && k < count; ++k) check_face_of[to_check[k]] = 1;
-      const std::size_t nf = g.faces.rows();
-      std::vector<std::vector<std::pair<Index, Constraint>>> face_found((nf + kBlock - 1) / kBlock);
-      std::vector<std::size_t> faces_in(face_found.size(), 0);
-      const bool last_round = round + 1 >= rounds;
-      parallel_for(0, face_found.size(), 1, [&](std::size_t b, std::size_t e) {
-        std::vector<Constraint> need;
-        for (std::size_t blk = b; blk < e; ++blk)
-          for (std::size_t f = blk * kBlock; f < std::min(nf, (blk + 1) * kBlock); ++f) {
-            const auto face = g.faces.row(f);
-            if (face.size() < 3) continue;
-            bool check = all, ok = true;
-            for (Index v : face) {
-              check = check || check_face_of[v];
-              ok = ok && finite[v];
-            }
-            if (!check || !ok) continue;
-            // Only counted (not asked of) while a corner is constrained, so only inside or not is needed.
-            const bool waits =
-                !last_round && std::any_of(face.begin(), face.end(), [&](Index v) { return constrained[v] != 0; });
-            const bool in =
-                face_needs(g, positions, f, body_b, options.face_clearance, &outside_by, waits ? nullptr : &need);
-            faces_in[blk] += in;
-            if (all) face_inside_before[f] = in;
-            if (waits) continue;
-            for (std::size_t i = 0; i < face.size(); ++i)
-              if (need[i].active) face_found[blk].emplace_back(face[i], need[i]);
-          }
-      });
-      for (const auto& list : found)
-        for (const auto& ic : list) constrained[ic.first] = 0;
-      std::vector<std::pair<Index, Constraint>> by_vertex;
-      for (const auto& list : found) by_vertex.insert(by_vertex.end(), list.begin(), list.end());
-      const std::size_t vertex_constraints = by_vertex.size();
-      for (const auto& list : face_found) by_vertex.insert(by_vertex.end(), list.begin(), list.end());
-      // By vertex, in a fixed order (the vertex's own first, then faces in order), largest amount kept.
-      std::stable_sort(by_vertex.begin(), by_vertex.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-      std::vector<Index> active;  // ascending
-      std::vector<Constraint> con;  // aligned with `active`
-      for (const auto& [i, c] : by_vertex) {
-        if (!active.empty() && active.back() == i) {
-          if (c.amount > con.back().amount) con.back() = Constraint{c.dir, c.amount, true, con.back().inside};
-          continue;
+  // Remembers where a vertex started before the step first moves it.
+  const auto touch = [&](Index i) {
+    if (is_touched[i]) return;
+    is_touched[i] = 1;
+    touched_slot[i] = Index(touched.size());
+    touched.push_back(i);
+    first_position.push_back(row3(positions, i));
+  };
+  // One round: `all`: check every vertex and face (else those of to_check);
+  // `last_round`: faces with a constrained corner are asked now, not next time.
+  // Returns false when nothing was too close.
+  const auto correction_round = [&](bool all, bool last_round) -> bool {
+    // 1. Which vertices are inside or too close, and where they must go: fixed
+    // blocks, each listing its constrained vertices, joined in block order.
+    const std::size_t count = all ? n : to_check.size();
+    constexpr std::size_t kBlock = kGrain / 4;
+    std::vector<std::vector<std::pair<Index, Constraint>>> found((count + kBlock - 1) / kBlock);
+    parallel_for(0, found.size(), 1, [&](std::size_t b, std::size_t e) {
+      for (std::size_t blk = b; blk < e; ++blk)
+        for (std::size_t k = blk * kBlock; k < std::min(count, (blk + 1) * kBlock); ++k) {
+          const Index i = all ? static_cast<Index>(k) : to_check[k];
+          if (!finite[i]) continue;
+          const Vec3 p = row3(positions, i);
+          const SignedClosestPoint cp = body_b.closest_and_inside(p, reach);
+          const bool in = cp.inside;
+          outside_by[i] = in ? 0.0 : std::min(cp.distance, reach);
+          near_point[i] = cp.point;
+          near_distance[i] = cp.distance;
+          const Constraint c = constraint_at(p, in, cp, options.clearance);
+          if (c.active) found[blk].emplace_back(i, c);
         }
-        active.push_back(i);
-        con.push_back(c);
-      }
-      if (all) {
-        report.too_close = vertex_constraints;
-        for (const auto& list : found)
-          for (const auto& ic : list) report.inside_before += ic.second.inside ? 1 : 0;
-        for (std::size_t k : faces_in) report.faces_inside_before += k;
-      }
-      if (active.empty()) break;
-      report.rounds = first_round + round + 1;
-
-      // 2. The region a correction may spread over: up to smoothing_rings edges away.
-      std::vector<Index> region = active;
-      for (Index i : active) ring[i] = 0;
-      for (std::size_t head = 0, level_end = region.size(), level = 0;
-           head < region.size() && static_cast<int>(level) < options.smoothing_rings; ++level) {
-        for (; head < level_end; ++head)
-          for (Index j : adj.row(region[head]))
-            if (ring[j] < 0 && finite[j]) {
-              ring[j] = static_cast<int>(level) + 1;
-              region.push_back(j);
-            }
-        level_end = region.size();
-      }
-      std::sort(region.begin(), region.end());  // mesh order: deterministic and cache-friendly
-      for (Index i : region)
-        if (!is_touched[i]) {
-          is_touched[i] = 1;
-          touched_slot[i] = Index(touched.size());
-          touched.push_back(i);
-          first_position.push_back(row3(positions, i));
+    });
+    // Faces too: a coarse face whose corners all clear the body can still have
+    // the body poking through its middle (the real dress's bust: 115 face centres
+    // inside body B, none of its corners). A face whose centre is inside or too
+    // close gives each corner its centre's constraint (moving all corners by it
+    // moves the centre by it); a corner with several keeps the largest.
+    // A face with a constrained corner waits for the next round: that corner's own
+    // move usually clears it, and asking its other corners now as well lifted
+    // vertices that sat on the body (the real jeans: 0.13 cm off body A, 0.81 off B).
+    for (const auto& list : found)
+      for (const auto& ic : list) constrained[ic.first] = 1;
+    std::vector<std::uint8_t> check_face_of(all ? 0 : n, 0);
+    if (all) face_inside_before.assign(g.faces.rows(), 0);
+    for (std::size_t k = 0; !all && k < count; ++k) check_face_of[to_check[k]] = 1;
+    const std::size_t nf = g.faces.rows();
+    std::vector<std::vector<std::pair<Index, Constraint>>> face_found((nf + kBlock - 1) / kBlock);
+    std::vector<std::size_t> faces_in(face_found.size(), 0);
+    parallel_for(0, face_found.size(), 1, [&](std::size_t b, std::size_t e) {
+      std::vector<Constraint> need;
+      for (std::size_t blk = b; blk < e; ++blk)
+        for (std::size_t f = blk * kBlock; f < std::min(nf, (blk + 1) * kBlock); ++f) {
+          const auto face = g.faces.row(f);
+          if (face.size() < 3) continue;
+          bool check = all, ok = true;
+          for (Index v : face) {
+            check = check || check_face_of[v];
+            ok = ok && finite[v];
+          }
+          if (!check || !ok) continue;
+          // Only counted (not asked of) while a corner is constrained, so only inside or not is needed.
+          const bool waits =
+              !last_round && std::any_of(face.begin(), face.end(), [&](Index v) { return constrained[v] != 0; });
+          const bool in =
+              face_needs(g, positions, f, body_b, options.face_clearance, &outside_by, waits ? nullptr : &need);
+          faces_in[blk] += in;
+          if (all) face_inside_before[f] = in;
+          if (waits) continue;
+          for (std::size_t i = 0; i < face.size(); ++i)
+            if (need[i].active) face_found[blk].emplace_back(face[i], need[i]);
         }
+    });
+    for (const auto& list : found)
+      for (const auto& ic : list) constrained[ic.first] = 0;
+    std::vector<std::pair<Index, Constraint>> by_vertex;
+    for (const auto& list : found) by_vertex.insert(by_vertex.end(), list.begin(), list.end());
+    const std::size_t vertex_constraints = by_vertex.size();
+    for (const auto& list : face_found) by_vertex.insert(by_vertex.end(), list.begin(), list.end());
+    // By vertex, in a fixed order (the vertex's own first, then faces in order), largest amount kept.
+    std::stable_sort(by_vertex.begin(), by_vertex.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    std::vector<Index> active;  // ascending
+    std::vector<Constraint> con;  // aligned with `active`
+    for (const auto& [i, c] : by_vertex) {
+      if (!active.empty() && active.back() == i) {
+        if (c.amount > con.back().amount) con.back() = Constraint{c.dir, c.amount, true, con.back().inside};
+        continue;
+      }
+      active.push_back(i);
+      con.push_back(c);
+    }
+    if (all) {
+      report.too_close = vertex_constraints;
+      for (const auto& list : found)
+        for (const auto& ic : list) report.inside_before += ic.second.inside ? 1 : 0;
+      for (std::size_t k : faces_in) report.faces_inside_before += k;
+    }
+    if (active.empty()) return false;
+    ++report.rounds;
 
-      // 3. Jacobi smoothing of the displacement field; constrained vertices keep
-      // at least their required displacement along their direction. Vertices out of
-      // the region count as fixed (zero), which gives the correction its falloff.
-      const std::size_t m = region.size();
-      std::vector<Vec3> disp(m, Vec3::Zero()), next(m);
-      for (std::size_t k = 0; k < m; ++k) slot[region[k]] = static_cast<long>(k);
-      auto slot_of = [&](Index v) -> long { return slot[v]; };
-      // Each region vertex's in-region neighbours, as slots of `region` (CSR).
-      std::vector<std::size_t> row_start(m + 1, 0);
-      parallel_for(0, m, 1024, [&](std::size_t b, std::size_t e) {
-        for (std::size_t k = b; k < e; ++k)
-          for (Index j : adj.row(region[k])) row_start[k + 1] += slot_of(j) >= 0;
+    // 2. The region a correction may spread over: up to smoothing_rings edges away.
+    std::vector<Index> region = active;
+    for (Index i : active) ring[i] = 0;
+    for (std::size_t head = 0, level_end = region.size(), level = 0;
+         head < region.size() && static_cast<int>(level) < options.smoothing_rings; ++level) {
+      for (; head < level_end; ++head)
+        for (Index j : adj.row(region[head]))
+          if (ring[j] < 0 && finite[j]) {
+            ring[j] = static_cast<int>(level) + 1;
+            region.push_back(j);
+          }
+      level_end = region.size();
+    }
+    std::sort(region.begin(), region.end());  // mesh order: deterministic and cache-friendly
+    for (Index i : region) touch(i);
+
+    // 3. Jacobi smoothing of the displacement field; constrained vertices keep
+    // at least their required displacement along their direction. Vertices out of
+    // the region count as fixed (zero), which gives the correction its falloff.
+    const std::size_t m = region.size();
+    std::vector<Vec3> disp(m, Vec3::Zero()), next(m);
+    for (std::size_t k = 0; k < m; ++k) slot[region[k]] = static_cast<long>(k);
+    auto slot_of = [&](Index v) -> long { return slot[v]; };
+    // Each region vertex's in-region neighbours, as slots of `region` (CSR).
+    std::vector<std::size_t> row_start(m + 1, 0);
+    parallel_for(0, m, 1024, [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k)
+        for (Index j : adj.row(region[k])) row_start[k + 1] += slot_of(j) >= 0;
+    });
+    for (std::size_t k = 0; k < m; ++k) row_start[k + 1] += row_start[k];
+    std::vector<std::size_t> row_slots(row_start[m]);
+    parallel_for(0, m, 1024, [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) {
+        std::size_t at = row_start[k];
+        for (Index j : adj.row(region[k]))
+          if (slot_of(j) >= 0) row_slots[at++] = std::size_t(slot_of(j));
+      }
+    });
+    // The constraint of each region slot, if any (both lists ascending).
+    std::vector<const Constraint*> con_at(m, nullptr);
+    for (std::size_t k = 0, a = 0; k < m && a < active.size(); ++k)
+      if (region[k] == active[a]) con_at[k] = &con[a++];
+    // Eq. 14's promise kept here too: a vertex near body B (within near_band)
+    // moves away from it by at most what it needs plus max_lift, so the spread
+    // of a deeper neighbour's push does not lift what sat on the body (measured
+    // on the real dress: vertices on body A ended 0.75 cm off body B). Farther
+    // vertices take the spread freely: it keeps the correction smooth.
+    std::vector<Vec3> cap_dir(m, Vec3::Zero());
+    std::vector<double> cap(m, std::numeric_limits<double>::infinity());
+    std::vector<double> sink_floor(m, -std::numeric_limits<double>::infinity());  // nor sink into the clearance
+    if (options.near_band > 0.0)
+      parallel_for(0, m, 256, [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) {
+          const Vec3 p = row3(positions, region[k]);
+          if (!(near_distance[region[k]] < options.near_band)) continue;
+          const Vec3 away = p - near_point[region[k]];
+          const double len = away.norm();
+          if (con_at[k]) {
+            cap_dir[k] = con_at[k]->dir;
+            cap[k] = con_at[k]->amount + options.max_lift;
+          } else if (len > 1e-12 * (1.0 + p.norm())) {
+            // The lift is a budget for the whole step, not per round.
+            cap_dir[k] = away / len;
+            const double lifted = (p - first_position[touched_slot[region[k]]]).dot(cap_dir[k]);
+            cap[k] = std::max(0.0, options.max_lift - lifted);
+            sink_floor[k] = std::min(0.0, options.clearance - len);
+          }
+        }
       });
-      for (std::size_t k = 0; k < m; ++k) row_start[k + 1] += row_start[k];
-      std::vector<std::size_t> row_slots(row_start[m]);
+    auto enforce = [&](std::size_t k, Vec3& d) {
+      if (options.pinned && (*options.pinned)[region[k]] && !con_at[k]) {
+        d = Vec3::Zero();
+        return;
+      }
+      const double lift = d.dot(cap_dir[k]);
+      if (lift > cap[k]) d -= (lift - cap[k]) * cap_dir[k];
+      if (lift < sink_floor[k]) d += (sink_floor[k] - lift) * cap_dir[k];
+      const Constraint* c = con_at[k];
+      if (!c) return;
+      const double along = d.dot(c->dir);
+      if (along < c->amount) d += (c->amount - along) * c->dir;
+    };
+    for (std::size_t k = 0; k < m; ++k) enforce(k, disp[k]);
+    for (int pass = 0; pass < options.smoothing_passes; ++pass) {
       parallel_for(0, m, 1024, [&](std::size_t b, std::size_t e) {
         for (std::size_t k = b; k < e; ++k) {
-          std::size_t at = row_start[k];
-          for (Index j : adj.row(region[k]))
-            if (slot_of(j) >= 0) row_slots[at++] = std::size_t(slot_of(j));
+          Vec3 sum = disp[k];
+          for (std::size_t r = row_start[k]; r < row_start[k + 1]; ++r) sum += disp[row_slots[r]];
+          // Out-of-region neighbours contribute zero but still count.
+          const double deg = 1.0 + static_cast<double>(adj.row_size(region[k]));
+          next[k] = sum / deg;
+          enforce(k, next[k]);
         }
       });
-      // The constraint of each region slot, if any (both lists ascending).
-      std::vector<const Constraint*> con_at(m, nullptr);
-      for (std::size_t k = 0, a = 0; k < m && a < active.size(); ++k)
-        if (region[k] == active[a]) con_at[k] = &con[a++];
-      // Eq. 14's promise kept here too: a vertex near body B (within near_band)
-      // moves away from it by at most what it needs plus max_lift, so the spread
-      // of a deeper neighbour's push does not lift what sat on the body (measured
-      // on the real dress: vertices on body A ended 0.75 cm off body B). Farther
-      // vertices take the spread freely: it keeps the correction smooth.
-      std::vector<Vec3> cap_dir(m, Vec3::Zero());
-      std::vector<double> cap(m, std::numeric_limits<double>::infinity());
-      std::vector<double> sink_floor(m, -std::numeric_limits<double>::infinity());  // nor sink into the clearance
-      if (options.near_band > 0.0)
-        parallel_for(0, m, 256, [&](std::size_t b, std::size_t e) {
-          for (std::size_t k = b; k < e; ++k) {
-            const Vec3 p = row3(positions, region[k]);
-            if (!(near_distance[region[k]] < options.near_band)) continue;
-            const Vec3 away = p - near_point[region[k]];
-            const double len = away.norm();
-            if (con_at[k]) {
-              cap_dir[k] = con_at[k]->dir;
-              cap[k] = con_at[k]->amount + options.max_lift;
-            } else if (len > 1e-12 * (1.0 + p.norm())) {
-              // The lift is a budget for the whole step, not per round.
-              cap_dir[k] = away / len;
-              const double lifted = (p - first_position[touched_slot[region[k]]]).dot(cap_dir[k]);
-              cap[k] = std::max(0.0, options.max_lift - lifted);
-              sink_floor[k] = std::min(0.0, options.clearance - len);
-            }
-          }
-        });
-      auto enforce = [&](std::size_t k, Vec3& d) {
-        if (options.pinned && (*options.pinned)[region[k]] && !con_at[k]) {
-          d = Vec3::Zero();
-          return;
-        }
-        const double lift = d.dot(cap_dir[k]);
-        if (lift > cap[k]) d -= (lift - cap[k]) * cap_dir[k];
-        if (lift < sink_floor[k]) d += (sink_floor[k] - lift) * cap_dir[k];
-        const Constraint* c = con_at[k];
-        if (!c) return;
-        const double along = d.dot(c->dir);
-        if (along < c->amount) d += (c->amount - along) * c->dir;
-      };
-      for (std::size_t k = 0; k < m; ++k) enforce(k, disp[k]);
-      for (int pass = 0; pass < options.smoothing_passes; ++pass) {
-        parallel_for(0, m, 1024, [&](std::size_t b, std::size_t e) {
-          for (std::size_t k = b; k < e; ++k) {
-            Vec3 sum = disp[k];
-            for (std::size_t r = row_start[k]; r < row_start[k + 1]; ++r) sum += disp[row_slots[r]];
-            // Out-of-region neighbours contribute zero but still count.
-            const double deg = 1.0 + static_cast<double>(adj.row_size(region[k]));
-            next[k] = sum / deg;
-            enforce(k, next[k]);
-          }
-        });
-        std::swap(disp, next);
-      }
-      unfold(g, positions, region, slot_of, options.unfold_passes, disp);
-      if (options.pinned)
-        for (std::size_t k = 0; k < m; ++k)
-          if ((*options.pinned)[region[k]] && !con_at[k]) disp[k] = Vec3::Zero();
-      parallel_for(0, m, 1024, [&](std::size_t b, std::size_t e) {
-        for (std::size_t k = b; k < e; ++k) positions.row(region[k]) += disp[k].transpose();
-      });
-      for (Index i : region) ring[i] = -1, slot[i] = -1;
-      to_check = std::move(region);
+      std::swap(disp, next);
     }
-    if (again || !options.symmetrise) break;
-    // The symmetrisation's new positions; what it moved is checked again.
-    first_round = report.rounds;
+    unfold(g, positions, region, slot_of, options.unfold_passes, disp);
+    if (options.pinned)
+      for (std::size_t k = 0; k < m; ++k)
+        if ((*options.pinned)[region[k]] && !con_at[k]) disp[k] = Vec3::Zero();
+    parallel_for(0, m, 1024, [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) positions.row(region[k]) += disp[k].transpose();
+    });
+    for (Index i : region) ring[i] = -1, slot[i] = -1;
+    to_check = std::move(region);
+    return true;
+  };
+  const int max_rounds = std::max(1, options.max_rounds);
+  for (int round = 0; round < max_rounds; ++round)
+    if (!correction_round(round == 0, round + 1 == max_rounds)) break;
+  // With options.symmetrise: its new positions, then one more round over what it
+  // moved. One: on the real garments of the quality suite 1, 2 or 5 give the
+  // same figures, and on the 1M dress the step took 2.7 s with 1 and 3.2 s with 5.
+  if (options.symmetrise) {
     to_check.clear();
     for (const auto& [i, p] : options.symmetrise(positions)) {
-      if (!is_touched[i]) {
-        is_touched[i] = 1;
-        touched_slot[i] = Index(touched.size());
-        touched.push_back(i);
-        first_position.push_back(row3(positions, i));
-      }
+      touch(i);
       positions.row(i) = p.transpose();
       to_check.push_back(i);
     }
     std::sort(to_check.begin(), to_check.end());
-    if (to_check.empty()) break;
+    if (!to_check.empty()) correction_round(false, true);
   }
   // Anything still inside after the last round (reported, never hidden).
   if (report.rounds > 0) {
