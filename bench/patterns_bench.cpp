@@ -95,14 +95,17 @@ int main(int argc, char** argv) {
   int repeat = 5;
   std::size_t faces = 100000;
   std::vector<std::size_t> threads = {1, 2};
+  FlattenOptions options;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--faces") && i + 1 < argc) faces = std::strtoul(argv[++i], nullptr, 10);
+    else if (!std::strcmp(argv[i], "--conformal-iterations") && i + 1 < argc)
+      options.conformal_iterations = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--threads")) {
       threads.clear();
       while (i + 1 < argc && argv[i + 1][0] != '-') threads.push_back(std::strtoul(argv[++i], nullptr, 10));
     } else {
-      std::fprintf(stderr, "usage: patterns_bench [--repeat N] [--faces N] [--threads T...]\n");
+      std::fprintf(stderr, "usage: patterns_bench [--repeat N] [--faces N] [--threads T...] [--conformal-iterations N]\n");
       return 2;
     }
   }
@@ -117,7 +120,7 @@ int main(int argc, char** argv) {
       for (int r = 0; r < repeat; ++r) {
         const double c0 = cpu_seconds();
         const auto w0 = std::chrono::steady_clock::now();
-        last = flatten_piece(piece.xyz, piece.triangles);
+        last = flatten_piece(piece.xyz, piece.triangles, options);
         wall.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w0).count());
         cpu.push_back(1e3 * (cpu_seconds() - c0));
         factor.push_back(last.factor_ms);

@@ -105,6 +105,7 @@ Pattern flatten_pattern(const Garment& g, const PatternCut& cut, const Points& p
                                   : flatten_piece(xyz[k], panel.triangles, options.flatten);
         piece.uv = f.uv;
         piece.iterations += f.iterations;
+        piece.flatten_ms += f.factor_ms + f.conformal_ms + f.arap_ms;
         piece.converged = f.converged;
         piece.flattened = true;
       }

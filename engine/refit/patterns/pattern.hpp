@@ -66,6 +66,7 @@ struct PatternPiece {
   PieceMeasures measures;
   int iterations = 0;
   bool converged = false;
+  double flatten_ms = 0;             // wall time of its flattenings (factorisations, conformal start, ARAP)
   double rotation = 0;               // radians the flattened piece was turned by to put its grain up
 };
 
