@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 namespace refit {
 namespace {
@@ -130,6 +131,35 @@ TEST(Collision, PushedTopComesOutSmoothlyAndOnlyLocally) {
   EXPECT_EQ(none.too_close, 0u);
   EXPECT_EQ(none.moved, 0u);
   EXPECT_TRUE(designed == p.garment.positions);
+}
+
+// Rounds after the first repair what the last one left, each correction spread
+// by its size: they check fewer vertices than rounds that spread every repair over
+// smoothing_rings, and the garment comes out as clear of the body, unfolded and
+// within a hair of it.
+TEST(Collision, SmallRepairsSpreadLessThanTheFirstCorrection) {
+  Pushed p = pushed_top();
+  const BodySurface body(p.body);
+  CollisionOptions by_size, full;
+  full.repair_tilt = 0.0;
+  Points a = p.pushed, b = p.pushed;
+  const CollisionReport ra = resolve_penetrations(p.garment, a, body, by_size);
+  const CollisionReport rb = resolve_penetrations(p.garment, b, body, full);
+  ASSERT_GE(rb.rounds, 2) << "the fixture must need repair rounds";
+  EXPECT_LT(ra.rechecked, rb.rechecked);
+  EXPECT_EQ(ra.inside_after, 0u);
+  EXPECT_EQ(ra.faces_inside_after, 0u);
+  Garment pushed_garment = p.garment;
+  pushed_garment.positions = p.pushed;
+  EXPECT_EQ(measure_sanity(pushed_garment, a).flipped_faces, 0u);
+  double largest_difference = 0.0, closest = std::numeric_limits<double>::infinity();
+  for (Eigen::Index i = 0; i < a.rows(); ++i) {
+    largest_difference = std::max(largest_difference, (a.row(i) - b.row(i)).norm());
+    if ((a.row(i) - p.pushed.row(i)).squaredNorm() > 0.0)
+      closest = std::min(closest, body.closest(row3(a, static_cast<Index>(i))).distance);
+  }
+  EXPECT_LT(largest_difference, 0.05);
+  EXPECT_GT(closest, by_size.clearance - 0.01);
 }
 
 TEST(Collision, WhatTheSymmetrisationHookLeavesInsideIsPushedOutAgain) {

@@ -197,6 +197,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     // 1. Which vertices are inside or too close, and where they must go: fixed
     // blocks, each listing its constrained vertices, joined in block order.
     const std::size_t count = all ? n : to_check.size();
+    if (!all) report.rechecked += count;
     constexpr std::size_t kBlock = kGrain / 4;
     std::vector<std::vector<std::pair<Index, Constraint>>> found((count + kBlock - 1) / kBlock);
     parallel_for(0, found.size(), 1, [&](std::size_t b, std::size_t e) {
@@ -281,19 +282,35 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     if (active.empty()) return false;
     ++report.rounds;
 
-    // 2. The region a correction may spread over: up to smoothing_rings edges away.
+    // 2. The region a correction may spread over: smoothing_rings edges, or in a
+    // repair round as many as its size needs (options.repair_tilt). ring[] holds
+    // the rings a vertex may still pass the correction on.
     std::vector<Index> region = active;
-    for (Index i : active) ring[i] = 0;
-    for (std::size_t head = 0, level_end = region.size(), level = 0;
-         head < region.size() && static_cast<int>(level) < options.smoothing_rings; ++level) {
-      for (; head < level_end; ++head)
-        for (Index j : adj.row(region[head]))
-          if (ring[j] < 0 && finite[j]) {
-            ring[j] = static_cast<int>(level) + 1;
-            region.push_back(j);
-          }
-      level_end = region.size();
+    const int max_rings = std::max(0, options.smoothing_rings);
+    std::vector<std::vector<Index>> at_level(std::size_t(max_rings) + 1);
+    for (std::size_t a = 0; a < active.size(); ++a) {
+      const Index i = active[a];
+      int rings = max_rings;
+      if (!all && options.repair_tilt > 0.0 && adj.row_size(i) > 0) {
+        double edge = 0.0;
+        for (Index j : adj.row(i)) edge += (row3(positions, j) - row3(positions, i)).norm();
+        edge /= double(adj.row_size(i));
+        const double needed = con[a].amount / (options.repair_tilt * edge);
+        if (needed < max_rings) rings = std::max(1, static_cast<int>(std::ceil(needed)));
+      }
+      ring[i] = rings;
+      at_level[std::size_t(rings)].push_back(i);
     }
+    for (int level = max_rings; level > 0; --level)
+      for (Index v : at_level[std::size_t(level)]) {
+        if (ring[v] != level) continue;  // reached since from a larger correction
+        for (Index j : adj.row(v))
+          if (ring[j] < level - 1 && finite[j]) {
+            if (ring[j] < 0) region.push_back(j);
+            ring[j] = level - 1;
+            at_level[std::size_t(level - 1)].push_back(j);
+          }
+      }
     std::sort(region.begin(), region.end());  // mesh order: deterministic and cache-friendly
     for (Index i : region) touch(i);
 
@@ -441,7 +458,8 @@ nlohmann::json CollisionReport::to_json() const {
           {"inside_after", inside_after},
           {"faces_inside_before", faces_inside_before},
           {"faces_inside_after", faces_inside_after},
-          {"rounds", rounds}};
+          {"rounds", rounds},
+          {"rechecked", rechecked}};
 }
 
 }  // namespace refit
