@@ -135,9 +135,10 @@ bool face_needs(const Garment& g, const Points& positions, std::size_t f, const 
   return inside;
 }
 
-bool face_inside(const Garment& g, const Points& positions, std::size_t f, const BodySurface& body) {
+bool face_inside(const Garment& g, const Points& positions, std::size_t f, const BodySurface& body,
+                 const std::vector<double>& outside_by) {
   if (g.faces.row_size(f) < 3) return false;
-  return face_needs(g, positions, f, body, 0.0, nullptr, nullptr);
+  return face_needs(g, positions, f, body, 0.0, &outside_by, nullptr);
 }
 
 }  // namespace
@@ -399,7 +400,10 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
       for (std::size_t k = 0; k < m; ++k)
         if ((*options.pinned)[region[k]] && !con_at[k]) disp[k] = Vec3::Zero();
     parallel_for(0, m, 1024, [&](std::size_t b, std::size_t e) {
-      for (std::size_t k = b; k < e; ++k) positions.row(region[k]) += disp[k].transpose();
+      for (std::size_t k = b; k < e; ++k) {
+        positions.row(region[k]) += disp[k].transpose();
+        if (disp[k] != Vec3::Zero()) outside_by[region[k]] = 0.0;  // unknown until checked again
+      }
     });
     for (Index i : region) ring[i] = -1, slot[i] = -1;
     to_check = std::move(region);
@@ -416,24 +420,28 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     for (const auto& [i, p] : options.symmetrise(positions)) {
       touch(i);
       positions.row(i) = p.transpose();
+      outside_by[i] = 0.0;
       to_check.push_back(i);
     }
     std::sort(to_check.begin(), to_check.end());
     if (!to_check.empty()) correction_round(false, true);
   }
-  // Anything still inside after the last round (reported, never hidden).
+  // Anything still inside after the last round (reported, never hidden). A
+  // vertex checked where it is now and found outside (outside_by > 0: zeroed
+  // whenever a vertex moves) needs no query, nor do the points of a face within
+  // such a corner's outside ball.
   if (report.rounds > 0) {
     const std::size_t t = touched.size();
     report.inside_after = deterministic_sum<std::size_t>(0, t, 256, 0, [&](std::size_t k) {
       const Vec3 p = row3(positions, touched[k]);
-      return p.allFinite() && body_b.inside(p) ? 1 : 0;
+      return outside_by[touched[k]] <= 0.0 && p.allFinite() && body_b.inside(p) ? 1 : 0;
     });
   }
   // Only faces with a moved corner can have changed.
   report.faces_inside_after = deterministic_sum<std::size_t>(0, g.faces.rows(), kGrain, 0, [&](std::size_t f) {
     const auto face = g.faces.row(f);
     const bool moved = std::any_of(face.begin(), face.end(), [&](Index v) { return is_touched[v] != 0; });
-    return std::size_t{moved ? face_inside(g, positions, f, body_b) : face_inside_before[f] != 0};
+    return std::size_t{moved ? face_inside(g, positions, f, body_b, outside_by) : face_inside_before[f] != 0};
   });
   double total = 0.0;
   for (std::size_t k = 0; k < touched.size(); ++k) {

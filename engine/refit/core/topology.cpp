@@ -275,51 +275,53 @@ std::vector<std::vector<Index>> boundary_loops_of(const std::vector<std::uint64_
 
 Csr vertex_adjacency(const Garment& g) {
   const std::size_t n = g.vertex_count();
-  std::vector<Index> count(n + 1, 0);
-  auto each_edge = [&](auto&& f) {
-    for (std::size_t r = 0; r < g.faces.rows(); ++r) {
-      const auto face = g.faces.row(r);
-      for (std::size_t k = 0; k < face.size(); ++k) f(face[k], face[(k + 1) % face.size()]);
-    }
-    for (std::size_t r = 0; r < g.lines.rows(); ++r) {
-      const auto line = g.lines.row(r);
-      for (std::size_t k = 0; k + 1 < line.size(); ++k) f(line[k], line[k + 1]);
+  // Every edge of the faces and `l` lines, both ways, scattered in parallel: a
+  // row's order depends on the threads until it is sorted below.
+  auto each_edge = [&](std::size_t b, std::size_t e, auto&& f) {
+    for (std::size_t r = b; r < e; ++r) {
+      const bool face = r < g.faces.rows();
+      const auto row = face ? g.faces.row(r) : g.lines.row(r - g.faces.rows());
+      const std::size_t edges = face ? row.size() : (row.size() > 0 ? row.size() - 1 : 0);
+      for (std::size_t k = 0; k < edges; ++k)
+        if (row[k] != row[(k + 1) % row.size()]) f(row[k], row[(k + 1) % row.size()]);
     }
   };
-  each_edge([&](Index a, Index b) {
-    if (a == b) return;
-    ++count[a + 1];
-    ++count[b + 1];
+  const std::size_t rows = g.faces.rows() + g.lines.rows();
+  std::vector<Index> count(n + 1, 0);
+  parallel_for(0, rows, 4096, [&](std::size_t b, std::size_t e) {
+    each_edge(b, e, [&](Index a, Index c) {
+      std::atomic_ref<Index>(count[a + 1]).fetch_add(1, std::memory_order_relaxed);
+      std::atomic_ref<Index>(count[c + 1]).fetch_add(1, std::memory_order_relaxed);
+    });
   });
-  Csr adj;
-  adj.offsets.assign(n + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) adj.offsets[i + 1] = adj.offsets[i] + count[i + 1];
-  adj.indices.resize(adj.offsets[n]);
-  std::vector<Index> fill(adj.offsets.begin(), adj.offsets.end() - 1);
-  each_edge([&](Index a, Index b) {
-    if (a == b) return;
-    adj.indices[fill[a]++] = b;
-    adj.indices[fill[b]++] = a;
+  std::vector<Index> start(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) start[i + 1] = start[i] + count[i + 1];
+  UninitVector<Index> all(start[n]);
+  std::vector<Index> fill(start.begin(), start.end() - 1);
+  parallel_for(0, rows, 4096, [&](std::size_t b, std::size_t e) {
+    each_edge(b, e, [&](Index a, Index c) {
+      all[std::atomic_ref<Index>(fill[a]).fetch_add(1, std::memory_order_relaxed)] = c;
+      all[std::atomic_ref<Index>(fill[c]).fetch_add(1, std::memory_order_relaxed)] = a;
+    });
   });
   // Sort and drop duplicates (shared edges appear once per face) row by row.
   std::vector<Index> row_size(n, 0);
   parallel_for(0, n, 4096, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
-      auto* first = adj.indices.data() + adj.offsets[i];
-      auto* last = adj.indices.data() + adj.offsets[i + 1];
+      Index* first = all.data() + start[i];
+      Index* last = all.data() + start[i + 1];
       std::sort(first, last);
       row_size[i] = static_cast<Index>(std::unique(first, last) - first);
     }
   });
-  Index out = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Index begin = adj.offsets[i];
-    std::copy(adj.indices.begin() + begin, adj.indices.begin() + begin + row_size[i], adj.indices.begin() + out);
-    adj.offsets[i] = out;
-    out += row_size[i];
-  }
-  adj.offsets[n] = out;
-  adj.indices.resize(out);
+  Csr adj;
+  adj.offsets.assign(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) adj.offsets[i + 1] = adj.offsets[i] + row_size[i];
+  adj.indices.resize(adj.offsets[n]);
+  parallel_for(0, n, 4096, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i)
+      std::copy_n(all.begin() + start[i], row_size[i], adj.indices.begin() + adj.offsets[i]);
+  });
   return adj;
 }
 
