@@ -34,6 +34,31 @@ void check_indices(const Garment& g) {
   check(g.points, "point");
 }
 
+/// Values put into n buckets in parallel: emit(begin, end, put) calls
+/// put(bucket, value) for items [begin, end) of [0, items). Each bucket is
+/// sorted, so the result does not depend on the threads (the fill order does).
+template <class Values, class Emit>
+void sorted_buckets(std::size_t n, std::size_t items, const Emit& emit, std::vector<Index>& start, Values& values) {
+  constexpr std::size_t kGrain = 1 << 14;
+  start.assign(n + 1, 0);
+  parallel_for(0, items, kGrain, [&](std::size_t b, std::size_t e) {
+    emit(b, e, [&](Index bucket, Index) {
+      std::atomic_ref<Index>(start[bucket + 1]).fetch_add(1, std::memory_order_relaxed);
+    });
+  });
+  for (std::size_t v = 0; v < n; ++v) start[v + 1] += start[v];
+  values.resize(start[n]);
+  std::vector<Index> fill(start.begin(), start.end() - 1);
+  parallel_for(0, items, kGrain, [&](std::size_t b, std::size_t e) {
+    emit(b, e, [&](Index bucket, Index value) {
+      values[std::atomic_ref<Index>(fill[bucket]).fetch_add(1, std::memory_order_relaxed)] = value;
+    });
+  });
+  parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t v = b; v < e; ++v) std::sort(values.begin() + start[v], values.begin() + start[v + 1]);
+  });
+}
+
 /// Every face side (consecutive corners, wrapping) as an undirected edge,
 /// bucketed by its smaller vertex: bucket v holds the larger vertices, sorted,
 /// in hi[start[v], start[v+1]); an edge used by k face sides appears k times.
@@ -45,34 +70,20 @@ struct FaceEdges {
 
 /// With `id`, each corner's vertex v stands for id[v] (welded vertices).
 FaceEdges face_edges(const Garment& g, const std::vector<Index>* id = nullptr) {
-  const std::size_t n = g.vertex_count(), faces = g.faces.rows();
-  constexpr std::size_t kGrain = 1 << 14;
-  const auto each_side = [&](std::size_t begin, std::size_t end, auto&& f) {
-    for (std::size_t r = begin; r < end; ++r) {
-      const auto row = g.faces.row(r);
-      for (std::size_t k = 0; k < row.size(); ++k) {
-        Index a = row[k], b = row[k + 1 == row.size() ? 0 : k + 1];
-        if (id) a = (*id)[a], b = (*id)[b];
-        if (a != b) f(std::min(a, b), std::max(a, b));
-      }
-    }
-  };
   FaceEdges e;
-  e.start.assign(n + 1, 0);
-  parallel_for(0, faces, kGrain, [&](std::size_t b, std::size_t end) {
-    each_side(b, end, [&](Index lo, Index) { std::atomic_ref<Index>(e.start[lo + 1]).fetch_add(1, std::memory_order_relaxed); });
-  });
-  for (std::size_t v = 0; v < n; ++v) e.start[v + 1] += e.start[v];
-  e.hi.resize(e.start[n]);
-  std::vector<Index> fill(e.start.begin(), e.start.end() - 1);
-  parallel_for(0, faces, kGrain, [&](std::size_t b, std::size_t end) {
-    each_side(b, end, [&](Index lo, Index h) {
-      e.hi[std::atomic_ref<Index>(fill[lo]).fetch_add(1, std::memory_order_relaxed)] = h;
-    });
-  });
-  parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t end) {
-    for (std::size_t v = b; v < end; ++v) std::sort(e.hi.begin() + e.start[v], e.hi.begin() + e.start[v + 1]);
-  });
+  sorted_buckets(
+      g.vertex_count(), g.faces.rows(),
+      [&](std::size_t begin, std::size_t end, auto&& put) {
+        for (std::size_t r = begin; r < end; ++r) {
+          const auto row = g.faces.row(r);
+          for (std::size_t k = 0; k < row.size(); ++k) {
+            Index a = row[k], b = row[k + 1 == row.size() ? 0 : k + 1];
+            if (id) a = (*id)[a], b = (*id)[b];
+            if (a != b) put(std::min(a, b), std::max(a, b));
+          }
+        }
+      },
+      e.start, e.hi);
   return e;
 }
 
@@ -275,44 +286,28 @@ std::vector<std::vector<Index>> boundary_loops_of(const std::vector<std::uint64_
 
 Csr vertex_adjacency(const Garment& g) {
   const std::size_t n = g.vertex_count();
-  // Every edge of the faces and `l` lines, both ways, scattered in parallel: a
-  // row's order depends on the threads until it is sorted below.
-  auto each_edge = [&](std::size_t b, std::size_t e, auto&& f) {
-    for (std::size_t r = b; r < e; ++r) {
-      const bool face = r < g.faces.rows();
-      const auto row = face ? g.faces.row(r) : g.lines.row(r - g.faces.rows());
-      const std::size_t edges = face ? row.size() : (row.size() > 0 ? row.size() - 1 : 0);
-      for (std::size_t k = 0; k < edges; ++k)
-        if (row[k] != row[(k + 1) % row.size()]) f(row[k], row[(k + 1) % row.size()]);
-    }
-  };
-  const std::size_t rows = g.faces.rows() + g.lines.rows();
-  std::vector<Index> count(n + 1, 0);
-  parallel_for(0, rows, 4096, [&](std::size_t b, std::size_t e) {
-    each_edge(b, e, [&](Index a, Index c) {
-      std::atomic_ref<Index>(count[a + 1]).fetch_add(1, std::memory_order_relaxed);
-      std::atomic_ref<Index>(count[c + 1]).fetch_add(1, std::memory_order_relaxed);
-    });
-  });
-  std::vector<Index> start(n + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) start[i + 1] = start[i] + count[i + 1];
-  UninitVector<Index> all(start[n]);
-  std::vector<Index> fill(start.begin(), start.end() - 1);
-  parallel_for(0, rows, 4096, [&](std::size_t b, std::size_t e) {
-    each_edge(b, e, [&](Index a, Index c) {
-      all[std::atomic_ref<Index>(fill[a]).fetch_add(1, std::memory_order_relaxed)] = c;
-      all[std::atomic_ref<Index>(fill[c]).fetch_add(1, std::memory_order_relaxed)] = a;
-    });
-  });
-  // Sort and drop duplicates (shared edges appear once per face) row by row.
+  // Every edge of the faces and `l` lines, both ways, bucketed by vertex.
+  std::vector<Index> start;
+  UninitVector<Index> all;
+  sorted_buckets(
+      n, g.faces.rows() + g.lines.rows(),
+      [&](std::size_t b, std::size_t e, auto&& put) {
+        for (std::size_t r = b; r < e; ++r) {
+          const bool face = r < g.faces.rows();
+          const auto row = face ? g.faces.row(r) : g.lines.row(r - g.faces.rows());
+          const std::size_t edges = face ? row.size() : (row.size() > 0 ? row.size() - 1 : 0);
+          for (std::size_t k = 0; k < edges; ++k) {
+            const Index a = row[k], c = row[(k + 1) % row.size()];
+            if (a != c) put(a, c), put(c, a);
+          }
+        }
+      },
+      start, all);
+  // Drop the duplicates (shared edges appear once per face) row by row.
   std::vector<Index> row_size(n, 0);
   parallel_for(0, n, 4096, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      Index* first = all.data() + start[i];
-      Index* last = all.data() + start[i + 1];
-      std::sort(first, last);
-      row_size[i] = static_cast<Index>(std::unique(first, last) - first);
-    }
+    for (std::size_t i = begin; i < end; ++i)
+      row_size[i] = static_cast<Index>(std::unique(all.data() + start[i], all.data() + start[i + 1]) - (all.data() + start[i]));
   });
   Csr adj;
   adj.offsets.assign(n + 1, 0);
