@@ -206,3 +206,51 @@ TEST(JointMatching, SamplesEndClearOfBodyB) {
   // Still one point where they meet.
   EXPECT_LT((row3(r.curves[1].optimised, 18) - row3(r.curves[0].optimised, 20)).norm(), 1e-9);
 }
+
+TEST(JointMatching, SamplesThatSatOnBodyAFollowBodyB) {
+  // Body B: below the floor y = dip(x), which sinks 1.2 around x = -5; body A
+  // was y < 0. The curve lies 0.5 above body A for x < 0 and rises away from
+  // it after; the warp keeps every sample's distance to the body, so the solve,
+  // restoring the straight line, lifts the part over the dip off body B.
+  const auto dip = [](double x) { return -1.2 * std::exp(-(x + 5.0) * (x + 5.0) / 6.0); };
+  Points s(41, 3);
+  for (int i = 0; i < 41; ++i) {
+    const double x = -10.0 + 0.5 * i;
+    s.row(i) << x, 0.5 + (x > 0.0 ? 0.4 * x : 0.0), 0.0;
+  }
+  const std::vector<FeatureCurve> curves = {
+      make_feature_curve("A", s, false, FeaturePlane::from_point_normal(Vec3::Zero(), Vec3::UnitZ()), {}, 0)};
+  const auto warp = [&](const Vec3& p) { return Vec3(p.x(), p.y() + dip(p.x()), p.z()); };
+  const auto distance = [&](const Vec3& p) { return p.y() - dip(p.x()); };
+  const ClearanceToBody floor = [&](const Vec3& p, double clearance) {
+    return ClearanceNeed{Vec3::UnitY(), clearance - distance(p)};
+  };
+  const auto run = [&](double follow) {
+    ShapeMatchingOptions o;
+    o.clearance = 0.1;
+    o.follow_body = follow;
+    o.follow_tolerance = 0.1;
+    std::vector<Points> ws, wa;
+    for (const FeatureCurve& c : curves) {
+      ws.push_back(map_rows(c.samples, warp));
+      wa.push_back(map_rows(c.aux, warp));
+    }
+    return match_shapes(prepare_shape_model(curves, o), ws, wa, distance, floor).curves[0];
+  };
+  const CurveResult free_curve = run(0.0), followed = run(1.0);
+  double free_off = 0.0, off = 0.0;
+  for (Eigen::Index i = 0; i < 21; ++i) {  // x <= 0: the samples 0.5 from body A
+    free_off = std::max(free_off, distance(row3(free_curve.optimised, Index(i))));
+    off = std::max(off, distance(row3(followed.optimised, Index(i))));
+    EXPECT_GE(distance(row3(followed.optimised, Index(i))), 0.1 - 1e-9) << i;
+  }
+  std::printf("[ info ] follow: farthest from body B of the samples 0.5 from body A: %.3f, without follow %.3f\n", off,
+              free_off);
+  EXPECT_GT(free_off, 0.9);          // the test means something
+  EXPECT_LE(off, 0.5 + 0.1 + 1e-6);  // the warp's distance, to the tolerance
+  EXPECT_FALSE(followed.followed.empty());
+  EXPECT_TRUE(free_curve.followed.empty());
+  // The part that never sat on the body keeps its shape: the rising end stays straight.
+  const Vec3 a = row3(followed.optimised, 30), b = row3(followed.optimised, 35), c = row3(followed.optimised, 40);
+  EXPECT_LT((b - 0.5 * (a + c)).norm(), 0.02);
+}

@@ -36,10 +36,11 @@ struct ResizeArgs {
        ordered_features = false;
   SurfaceOptions surface;
   double clearance = 0.2;
+  double follow_body = 0.0;
   PatternsOptions patterns;  // --patterns-out: the 2D patterns of each result (docs/patterns.md)
 };
 
-// A finite clearance from 0 to 10 cm: nan, inf or 1e6 would push the garment away (issue 17).
+// A finite distance from 0 to 10 cm (the clearance, --follow-body): nan, inf or 1e6 would push the garment away (issue 17).
 std::string check_clearance(const std::string& s) {
   double v = 0;
   try {
@@ -229,6 +230,7 @@ int run(ResizeArgs a) {
   options.symmetry = parse_symmetry(!a.symmetry.empty() ? a.symmetry : paper ? "none" : "auto");
   options.metrics = a.metrics;
   options.clearance_cm = a.clearance;
+  options.follow_body_cm = a.follow_body;
   if (!a.curves_out.empty() && a.features.empty()) throw Error("--curves-out needs --features");
   if (!a.curves_out.empty() && batch) throw Error("--curves-out works with one --to body");
   if (!a.out_dir.empty()) {
@@ -428,6 +430,12 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
   app.add_option("--clearance", a->clearance, "Collision clearance outside body B in cm (0 to 10)")
       ->check(check_clearance)
       ->capture_default_str();
+  app.add_option("--follow-body", a->follow_body,
+                 "Feature curve samples that sat within this of body A (cm, e.g. 1) keep their distance to body B, "
+                 "so a fitted part follows the body; 0: the curves keep their shape there too (docs/method.md)")
+      ->check(check_clearance)
+      ->capture_default_str()
+      ->group(kAdvanced);
   app.add_flag("--metrics", a->metrics, "Add fit, penetration and surface metrics of the warp and the result to the report");
   app.add_option("--memory-budget", a->memory_budget,
                  "Memory a run may use (e.g. 800M, 1G): above it the garment is resized in chunks streamed from and to "

@@ -77,6 +77,13 @@ struct ShapeMatchingOptions {
   /// margin, so the collision step finds nothing to move on the curves.
   double clearance = 0.0;
   int clearance_rounds = 6;
+  /// Joint solve with a clearance: samples the warp leaves within this distance
+  /// of body B (garment units; 0: off) that the solve moves more than
+  /// follow_tolerance farther off are pulled back to that band (see
+  /// joint_matching.cpp). The pipeline passes 1 cm: where the garment sat on
+  /// body A it follows body B.
+  double follow_body = 0.0;
+  double follow_tolerance = 0.0;  // garment units
 };
 
 /// The weight actually applied to the raw sum of eq. 8 for a curve of m samples
@@ -131,6 +138,7 @@ struct CurveResult {
   std::vector<FixedSample> fixed;      // in order: the two samples chosen by the heuristic; joint: the one held
   std::vector<FixedSample> crossings;  // samples on an earlier curve (in order: fixed where it put them; joint: shared)
   std::vector<FixedSample> cleared;    // joint: samples held at the clearance from body B (distance: how far they moved)
+  std::vector<FixedSample> followed;   // joint: samples pulled back towards body B (distance: how far they moved)
   double energy_warped = 0.0, energy_result = 0.0;  // eq. 9 (weights as applied) at the projected warped samples and at the result
   double shape_error_warped = 0.0, shape_error_result = 0.0;  // see curve_metrics.hpp
   double turning_angle_change_warped_deg = 0.0, turning_angle_change_result_deg = 0.0;
@@ -148,7 +156,8 @@ struct FeatureResult {
 using DistanceToBody = std::function<double(const Vec3&)>;
 
 /// What a point needs to clear body B by a clearance: the unit direction away
-/// from the body and how far it must still move along it (<= 0: clear).
+/// from the body and how far it must still move along it (< 0: clear, by how
+/// much it is farther off than the clearance).
 struct ClearanceNeed {
   Vec3 direction = Vec3::Zero();
   double amount = 0.0;

@@ -28,12 +28,13 @@ std::vector<std::uint8_t> feature_corners(const SurfaceAttachment& attachment, E
 }
 
 // What a feature sample needs to clear body B: the collision step's rule, out
-// along the closest-point direction (inside: to the surface and the clearance beyond).
+// along the closest-point direction (inside: to the surface and the clearance
+// beyond; farther than the clearance: a negative amount, for the follow step).
 ClearanceNeed clearance_need(const BodySurface& body, const Vec3& p, double clearance) {
   ClearanceNeed need;
   const bool in = body.inside(p);
-  const ClosestPoint cp = in ? body.closest(p) : body.closest_within(p, clearance);
-  if (!in && !(cp.distance < clearance)) return need;
+  ClosestPoint cp = in ? body.closest(p) : body.closest_within(p, clearance);
+  if (!in && !(cp.distance < clearance)) cp = body.closest(p);
   const Vec3 towards = cp.point - p;
   const double len = towards.norm();
   need.direction = len > 1e-12 * (1.0 + p.norm()) ? Vec3((in ? towards : -towards) / len) : cp.normal;
@@ -117,6 +118,11 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
     // The curves end clear of body B by the collision clearance and a margin, so
     // the collision step finds nothing to move on them (issue 13: the written garment follows the curves).
     if (options_.collision && sm.clearance <= 0.0) sm.clearance = (options_.clearance_cm + kFeatureClearanceMarginCm) * per_cm;
+    // Where a curve sat on body A it follows body B (issue 13: vertices that sat on body A follow body B).
+    if (options_.collision && sm.follow_body <= 0.0 && options_.follow_body_cm > 0.0) {
+      sm.follow_body = options_.follow_body_cm * per_cm;
+      sm.follow_tolerance = kFeatureFollowToleranceCm * per_cm;
+    }
     features_ = bind_features(body_a_, std::move(curves), sm);
     if (sym.symmetric) feature_mirror_ = sample_mirror_pairs(features_->model.curves, mirror_x_);
     bind_report_["features"] = clock.ms();

@@ -35,6 +35,10 @@ class BodySurface;
 /// 1-2: the garment is the warp, the curves are optimised), or all three steps.
 enum class Stage { Warp, Features, Full };
 
+/// The band beyond the warp's distance to body B that a sample following the
+/// body (ResizeOptions::follow_body_cm) may keep.
+inline constexpr double kFeatureFollowToleranceCm = 0.3;
+
 struct ResizeOptions {
   std::string units = "cm";    // garment units; physical constants below are in cm
   Stage stage = Stage::Full;
@@ -45,6 +49,12 @@ struct ResizeOptions {
   SurfaceOptions surface;      // epsilon and voxel in cm here; converted to garment units
   bool collision = true;       // push vertices inside body B out (beyond the paper)
   double clearance_cm = 0.2;   // ... to this distance outside the body
+  /// With the collision step: feature samples the warp leaves within this of
+  /// body B keep the warp's distance to it, to kFeatureFollowToleranceCm
+  /// (ShapeMatchingOptions::follow_body): where a curve sat on body A it follows
+  /// body B. 0 (default): the curves keep their shape there too (docs/method.md
+  /// has the quality suite's figures of both).
+  double follow_body_cm = 0.0;
   bool metrics = false;        // add fit, penetration and sanity metrics (warp and result) to the report
   double memory_budget_mb = 0; // a run estimated above this is refused before the work (0: the machine's memory)
 };

@@ -95,12 +95,15 @@ nlohmann::json features_report(const FeatureResult& curves) {
     for (const FixedSample& f : c.crossings) crossings.push_back({{"index", f.index}, {"distance", f.distance}});
     nlohmann::json cleared = nlohmann::json::array();
     for (const FixedSample& f : c.cleared) cleared.push_back({{"index", f.index}, {"moved", f.distance}});
+    nlohmann::json followed = nlohmann::json::array();
+    for (const FixedSample& f : c.followed) followed.push_back({{"index", f.index}, {"moved", f.distance}});
     list.push_back({{"name", c.name},
                     {"samples", c.original.rows()},
                     {"closed", c.closed},
                     {"fixed", fixed},
                     {"crossings", crossings},
                     {"cleared", cleared},
+                    {"followed", followed},
                     {"scale_warped", c.scale_warped},
                     {"scale_result", c.scale_result},
                     {"shape_error_warped", c.shape_error_warped},
