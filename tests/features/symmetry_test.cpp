@@ -56,9 +56,10 @@ TEST(Symmetry, DetectsSymmetricPairAndRejectsAsymmetricOne) {
   EXPECT_LT(s.body_error, 1e-12);
   EXPECT_TRUE(s.symmetric);
 
-  // The garment: its 95th percentile decides (a few one-sided vertices pass, many do not).
+  // The garment: its 90th percentile decides (8 % one-sided vertices, as a
+  // suit's overlapping front, pass; 10 % do not).
   std::vector<double> few(100, 0.0), many(100, 0.0);
-  for (int i = 0; i < 3; ++i) few[static_cast<std::size_t>(i)] = 5.0;
+  for (int i = 0; i < 8; ++i) few[static_cast<std::size_t>(i)] = 5.0;
   for (int i = 0; i < 10; ++i) many[static_cast<std::size_t>(i)] = 5.0;
   EXPECT_TRUE(check_symmetry(1.0, few, body, 0.01, SymmetryMode::Auto).symmetric);
   const SymmetryCheck off = check_symmetry(1.0, many, body, 0.01, SymmetryMode::Auto);
@@ -87,6 +88,29 @@ TEST(Symmetry, MirrorsOneSidedCurvesOnly) {
   for (Eigen::Index i = 0; i < m.samples.rows(); ++i) EXPECT_NEAR(m.plane.signed_distance(row3(m.samples, static_cast<Index>(i))), 0.0, 1e-9);
   // Mirroring again adds nothing: every curve's mirror is now a feature.
   EXPECT_EQ(add_mirrored_curves(curves, 0.0).size(), 3u);
+}
+
+TEST(Symmetry, MirroredCurvesOffTheGarmentAreDropped) {
+  // The garment covers x >= -0.5 only (a one-sided part): the left profile's
+  // mirror falls off it, the centre curve and the left profile stay.
+  std::vector<FeatureCurve> curves = add_mirrored_curves({centre_curve(), side_curve()}, 0.0);
+  ASSERT_EQ(curves.size(), 3u);
+  const DistanceToGarment distance = [](const Points& p) {
+    std::vector<double> d(static_cast<std::size_t>(p.rows()));
+    for (Eigen::Index i = 0; i < p.rows(); ++i) d[static_cast<std::size_t>(i)] = std::max(0.0, -0.5 - p(i, 0));
+    return d;
+  };
+  const std::vector<std::string> dropped = drop_curves_off_garment(curves, 2, 0.1, distance);
+  EXPECT_EQ(dropped, std::vector<std::string>{"left~mirror"});
+  ASSERT_EQ(curves.size(), 2u);
+  EXPECT_EQ(curves[0].name, "front");
+  EXPECT_EQ(curves[1].name, "left");
+  // Given curves are never dropped, and a mirror on the garment is kept.
+  std::vector<FeatureCurve> on = add_mirrored_curves({centre_curve(), side_curve()}, 0.0);
+  EXPECT_TRUE(drop_curves_off_garment(on, 2, 0.1, [](const Points& p) {
+                return std::vector<double>(static_cast<std::size_t>(p.rows()), 0.05);
+              }).empty());
+  EXPECT_EQ(on.size(), 3u);
 }
 
 TEST(Symmetry, SymmetriseMakesPairedRowsMirrorImages) {

@@ -89,6 +89,12 @@ SurfaceAttachment attach_points(const Garment& original, const Points& samples) 
   return GarmentLocator(original).attach(samples);
 }
 
+std::vector<double> offset_lengths(const SurfaceAttachment& at) {
+  std::vector<double> d(static_cast<std::size_t>(at.offset.rows()));
+  for (Eigen::Index i = 0; i < at.offset.rows(); ++i) d[static_cast<std::size_t>(i)] = at.offset.row(i).norm();
+  return d;
+}
+
 Vec3 carry_one(const SurfaceAttachment& at, const Points& result, Index i) {
   const auto s = static_cast<std::size_t>(i);
   Vec3 q = row3(at.offset, i);

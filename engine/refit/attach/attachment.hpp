@@ -47,6 +47,9 @@ Points carry(const SurfaceAttachment& attachment, const Points& result);
 /// Attached point `i` on another state of the garment.
 Vec3 carry_one(const SurfaceAttachment& attachment, const Points& result, Index i);
 
+/// Per point, its distance to the garment's surface where it was attached (its offset's length).
+std::vector<double> offset_lengths(const SurfaceAttachment& attachment);
+
 /// attach_points then carry: the same material points on the result.
 Points carry_points(const Garment& original, const Points& result, const Points& samples);
 

@@ -130,7 +130,13 @@ ChunkedBinding::ChunkedBinding(std::shared_ptr<const GarmentStore> garment, Body
     progress.stage("sampling " + std::to_string(features.size()) + " feature curves");
     std::vector<FeatureCurve> curves = build_feature_curves(chunked_feature_garment(g, x, plan_), features);
     const std::size_t given = curves.size();
-    if (sym.symmetric) curves = add_mirrored_curves(std::move(curves), sym.plane_x);
+    if (sym.symmetric) {
+      curves = add_mirrored_curves(std::move(curves), sym.plane_x);
+      for (const std::string& name : drop_curves_off_garment(curves, given, sym.tolerance, [&](const Points& s) {
+             return offset_lengths(chunked_attach(g, x, plan_, s));
+           }))
+        bound_->symmetry_report["mirrors_off_garment"].push_back(name);
+    }
     for (std::size_t i = given; i < curves.size(); ++i) bound_->symmetry_report["mirrored_features"].push_back(curves[i].name);
     bound_->features = bind_features(body_a_, std::move(curves), options_.shape_matching);
     if (sym.symmetric) bound_->feature_mirror = sample_mirror_pairs(bound_->features->model.curves, bound_->mirror_x);

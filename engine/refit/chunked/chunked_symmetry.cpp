@@ -115,7 +115,7 @@ ChunkedMirror chunked_mirror_attach(const GarmentStore& g, const PointGather& x,
   pending->flush();
   std::vector<std::unique_ptr<Spool<Result>>> results;  // per round and slab, each in vertex order
   Spool<double> distances(folder);                     // of the images found
-  const std::size_t rank = percentile95_rank(n);
+  const std::size_t rank = symmetry_percentile_rank(n);
   double r = std::max(radius, 1e-6 * diagonal);
   for (;; r *= 4.0, ++out.rounds) {
     const bool everything = r >= 2.0 * diagonal;  // every element reaches every slab: all found

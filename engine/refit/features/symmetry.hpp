@@ -7,6 +7,7 @@
 #include <refit/features/feature_curves.hpp>
 #include <refit/features/shape_matching.hpp>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -19,8 +20,8 @@ SymmetryMode parse_symmetry(const std::string& s);
 
 struct SymmetryCheck {
   double plane_x = 0.0;        // the mirror plane x = plane_x
-  double garment_error = 0.0;  // 95th percentile distance from a mirrored garment vertex to the garment's surface
-  double body_error = 0.0;     // 95th percentile distance from a mirrored body A vertex to the nearest body A vertex
+  double garment_error = 0.0;  // 90th percentile distance from a mirrored garment vertex to the garment's surface
+  double body_error = 0.0;     // 90th percentile distance from a mirrored body A vertex to the nearest body A vertex
   double tolerance = 0.0;      // both errors must be at most this for Auto to detect symmetry
   bool symmetric = false;      // used: forced by X, detected by Auto, never with None
 };
@@ -33,10 +34,11 @@ double mirror_plane_x(const Points& body_a);
 /// meshes need not be vertex-symmetric). tolerance: in the garment's units.
 SymmetryCheck check_symmetry(double plane_x, const std::vector<double>& garment_mirror_distance, const Points& body_a,
                              double tolerance, SymmetryMode mode);
-/// The same with the garment's error (the 95th percentile of those distances) given.
+/// The same with the garment's error (the 90th percentile of those distances) given.
 SymmetryCheck check_symmetry(double plane_x, double garment_error, const Points& body_a, double tolerance, SymmetryMode mode);
-/// The rank (0-based, ascending) of the 95th percentile among `count` values.
-std::size_t percentile95_rank(std::size_t count);
+/// The rank (0-based, ascending) of the 90th percentile among `count` values:
+/// the symmetry check's (robust to one-sided details up to a tenth of the garment).
+std::size_t symmetry_percentile_rank(std::size_t count);
 
 /// p mirrored about x = c.
 Points mirror_x(const Points& p, double c);
@@ -45,6 +47,15 @@ Points mirror_x(const Points& p, double c);
 /// `coincide` spacings of an existing curve (itself included), its mirrored
 /// copy named "<name>~mirror" (appended after all given curves, in their order).
 std::vector<FeatureCurve> add_mirrored_curves(std::vector<FeatureCurve> curves, double c, double coincide = 2.0);
+
+/// Per point, its distance to the original garment's surface.
+using DistanceToGarment = std::function<std::vector<double>(const Points&)>;
+/// Removes the curves from `first` on (the mirrored copies) whose samples are
+/// not on the garment: the 90th percentile of their distances above
+/// `tolerance` (a curve on a one-sided part, such as a jacket's overlapping
+/// front). Returns their names, in order.
+std::vector<std::string> drop_curves_off_garment(std::vector<FeatureCurve>& curves, std::size_t first, double tolerance,
+                                                 const DistanceToGarment& distance);
 
 /// For each sample of the concatenated curves `samples` (original garment), the
 /// sample nearest its mirror about x = c, or -1 when none is within `tolerance`.

@@ -93,7 +93,7 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
   std::vector<double> mirror_distance;
   if (options_.symmetry != SymmetryMode::None) {
     mirror_at = locate().attach(mirror_x(garment_->positions, plane_x));
-    for (Eigen::Index i = 0; i < mirror_at.offset.rows(); ++i) mirror_distance.push_back(mirror_at.offset.row(i).norm());
+    mirror_distance = offset_lengths(mirror_at);
   }
   const SymmetryCheck sym = check_symmetry(plane_x, mirror_distance, body_a_.mesh().vertices,
                                            options_.symmetry_tolerance_cm * per_cm, options_.symmetry);
@@ -112,7 +112,13 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
     progress.stage("sampling " + std::to_string(features.size()) + " feature curves");
     std::vector<FeatureCurve> curves = build_feature_curves(*garment_, features);
     const std::size_t given = curves.size();
-    if (sym.symmetric) curves = add_mirrored_curves(std::move(curves), sym.plane_x);
+    if (sym.symmetric) {
+      curves = add_mirrored_curves(std::move(curves), sym.plane_x);
+      for (const std::string& name : drop_curves_off_garment(curves, given, sym.tolerance, [&](const Points& s) {
+             return offset_lengths(locate().attach(s));
+           }))
+        symmetry_report_["mirrors_off_garment"].push_back(name);
+    }
     for (std::size_t i = given; i < curves.size(); ++i) symmetry_report_["mirrored_features"].push_back(curves[i].name);
     ShapeMatchingOptions sm = options_.shape_matching;
     // The curves end clear of body B by the collision clearance and a margin, so
