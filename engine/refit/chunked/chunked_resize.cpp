@@ -147,7 +147,11 @@ ChunkedBinding::ChunkedBinding(std::shared_ptr<const GarmentStore> garment, Body
     progress.stage("building the agent system");
     const SurfaceOptions so = surface_options_in_units(options_);
     const Points all = bound_->features ? all_samples(bound_->features->model.curves) : Points(0, 3);
-    if (all.rows() > 0) bound_->feature_attachment = chunked_attach(g, x, plan_, all);
+    if (all.rows() > 0) {  // as in memory (resize.cpp): where each sample sits on its own layer
+      const Points anchors = all_sample_anchors(bound_->features->model.curves);
+      bound_->feature_attachment = chunked_attach(g, x, plan_, anchors);
+      bound_->feature_attachment.offset += all - anchors;
+    }
     std::vector<std::uint32_t> layers;
     try {
       SurfaceGarmentPart part = chunked_surface_part(g, x, plan_, all, so, bound_->feature_attachment, layers);

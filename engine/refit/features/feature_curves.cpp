@@ -142,7 +142,11 @@ FeatureCurve build_slice(const FeatureGarment& g, const FeatureSpec& s, double d
   if (s.samples < min_samples(closed))
     fail(s, "'samples' is " + std::to_string(s.samples) + ": an open curve needs at least 5 samples");
   const BSpline spline = fit_bspline(poly, s.fit_control_points, s.degree, closed);
-  return make_feature_curve(s.name, sample_by_arc_length(spline, s.samples), closed, *s.plane, o, stream);
+  FeatureCurve c = make_feature_curve(s.name, sample_by_arc_length(spline, s.samples), closed, *s.plane, o, stream);
+  c.on_piece.resize(c.samples.rows(), 3);
+  for (Eigen::Index i = 0; i < c.samples.rows(); ++i)
+    c.on_piece.row(i) = nearest_on_polyline(poly, closed, row3(c.samples, Index(i))).point.transpose();
+  return c;
 }
 
 FeatureCurve build_boundary(const FeatureGarment& g, const FeatureSpec& s, double diag, const FeatureCurveOptions& o,
@@ -174,6 +178,16 @@ FeatureCurve build_boundary(const FeatureGarment& g, const FeatureSpec& s, doubl
 }
 
 }  // namespace
+
+Points all_sample_anchors(std::span<const FeatureCurve> curves) {
+  Points out = all_samples(curves);
+  Eigen::Index row = 0;
+  for (const FeatureCurve& c : curves) {
+    if (c.on_piece.rows() == c.samples.rows()) out.middleRows(row, c.samples.rows()) = c.on_piece;
+    row += c.samples.rows();
+  }
+  return out;
+}
 
 Points all_samples(std::span<const FeatureCurve> curves) {
   Points out(0, 3);

@@ -24,6 +24,10 @@ struct FeatureCurve {
   Points samples;  // m x 3
   FeaturePlane plane;
   Points aux;      // (m * aux_per_sample) x 3, on `plane`
+  /// m x 3: each sample's nearest point on the cut piece it was fitted to (so on
+  /// the faces of its own layer: the fit leaves samples up to about 0.05 cm off),
+  /// or empty: the samples themselves lie on the garment (or need not).
+  Points on_piece;
 
   std::size_t size() const { return static_cast<std::size_t>(samples.rows()); }
   /// Mean distance between consecutive samples.
@@ -33,6 +37,10 @@ struct FeatureCurve {
 /// Every curve's samples, one curve after another: the order in which a
 /// binding numbers the samples of all curves.
 Points all_samples(std::span<const FeatureCurve> curves);
+/// The same rows as all_samples, each where its sample sits on the garment
+/// (FeatureCurve::on_piece where known): the points to attach, so that a curve
+/// is attached to the layer it was cut from, not to one just beneath it.
+Points all_sample_anchors(std::span<const FeatureCurve> curves);
 
 struct FeatureCurveOptions {
   std::size_t aux_per_sample = 4;

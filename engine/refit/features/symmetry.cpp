@@ -119,6 +119,7 @@ std::vector<FeatureCurve> add_mirrored_curves(std::vector<FeatureCurve> curves, 
     mc.samples = m;
     mc.plane = plane;
     mc.aux = mirror_x(src.aux, c);
+    if (src.on_piece.rows() > 0) mc.on_piece = mirror_x(src.on_piece, c);
     curves.push_back(std::move(mc));
   }
   return curves;

@@ -139,8 +139,13 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
     const SurfaceOptions so = surface_options_in_units(options_);
     const Points all = features_ ? all_samples(features_->model.curves) : Points(0, 3);
     // One pass over the garment for every curve's samples; the surface binding
-    // and the report's shape_error_output share it.
-    if (all.rows() > 0) feature_attachment_ = locate().attach(all);
+    // and the report's shape_error_output share it. Each sample is attached
+    // where it sits on its own layer, keeping its small offset from there.
+    if (all.rows() > 0) {
+      const Points anchors = all_sample_anchors(features_->model.curves);
+      feature_attachment_ = locate().attach(anchors);
+      feature_attachment_.offset += all - anchors;
+    }
     try {
       surface_ = SurfaceBinding::bind(*garment_, all, so, all.rows() > 0 ? &feature_attachment_ : nullptr);
     } catch (const Error& e) {  // e.g. a voxel size too small for the garment: name its file
