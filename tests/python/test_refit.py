@@ -124,11 +124,28 @@ def test_shared_dress_to_two_bodies(tmp_path):
         assert r.report["collision"]["inside_after"] == 0
 
 
+def test_follow_body_is_the_command_lines(tmp_path):
+    if not DATA or not os.path.isdir(os.path.join(DATA, "garments")):
+        pytest.skip("../shared/data is absent: real-data Python test skipped")
+    features = os.path.join(os.path.dirname(__file__), "..", "..", "bench", "quality", "features", "skirt.json")
+    garment = os.path.join(DATA, "garments", "skirt_on_A_female.obj")
+    body_a, body_b = (os.path.join(DATA, "bodies", b + ".obj") for b in ("A_female", "F_thinner"))
+    binding = refit.Binding(refit.read_garment(garment), refit.read_body(body_a), features=refit.read_features(features),
+                            follow_body=1.0)
+    out = tmp_path / "skirt.obj"
+    subprocess.run([CLI, "resize", "--garment", garment, "--from", body_a, "--to", body_b, "--features", features,
+                    "--follow-body", "1", "--out", str(out), "--quiet"], check=True)
+    r = binding.resize(refit.read_body(body_b))
+    assert np.array_equal(r.positions, positions_of(out))
+    assert any(c["followed"] for c in r.report["features"])  # the skirt's side profile sat on the hips
+
+
 def test_error_classes_are_the_command_lines_exit_classes(demo, tmp_path):
     g = refit.read_garment(str(demo / "dress.obj"))
     a = refit.read_body(str(demo / "A.obj"))
     # Usage (exit 2): the values `refit resize` refuses as usage errors.
     for kwargs, flag in (({"clearance": float("nan")}, ["--clearance", "nan"]), ({"threads": -1}, ["--threads", "-1"]),
+                         ({"follow_body": 11.0}, ["--follow-body", "11"]),
                          ({"units": "furlong"}, ["--units", "furlong"])):
         with pytest.raises(refit.UsageError) as e:
             refit.Binding(g, a, **kwargs)

@@ -141,12 +141,14 @@ class Binding {
  public:
   Binding(std::shared_ptr<const Garment> garment, const BodyMesh& body_a, const Features* features,
           const std::string& units, const std::string& stage, const std::string& symmetry, bool collision,
-          double clearance, long threads, bool metrics, const py::object& progress)
+          double clearance, long threads, bool metrics, const py::object& progress, double follow_body)
       : garment_(std::move(garment)) {
     check_units(units);
     check_threads(threads);
     if (!(clearance >= 0.0 && clearance <= 10.0))
       throw UsageError("clearance: " + std::to_string(clearance) + " is outside 0 to 10 cm");
+    if (!(follow_body >= 0.0 && follow_body <= 10.0))
+      throw UsageError("follow_body: " + std::to_string(follow_body) + " is outside 0 to 10 cm");
     threads_ = static_cast<std::size_t>(threads);
     ResizeOptions o;
     o.units = units;
@@ -154,6 +156,7 @@ class Binding {
     o.symmetry = symmetry_of(symmetry);
     o.collision = collision;
     o.clearance_cm = clearance;
+    o.follow_body_cm = follow_body;
     o.metrics = metrics;
     if (features && features->units != units)
       throw UsageError("features: read for units " + features->units + ", the binding's are " + units +
@@ -300,16 +303,17 @@ PYBIND11_MODULE(_refit, m) {
                       "number of bodies B, from any number of Python threads at once.")
       .def(py::init([](std::shared_ptr<Garment> g, const BodyMesh& a, const Features* features, const std::string& units,
                        const std::string& stage, const std::string& symmetry, bool collision, double clearance,
-                       long threads, bool metrics, const py::object& progress) {
+                       long threads, bool metrics, const py::object& progress, double follow_body) {
              return std::make_unique<Binding>(std::move(g), a, features, units, stage, symmetry, collision, clearance,
-                                              threads, metrics, progress);
+                                              threads, metrics, progress, follow_body);
            }),
            py::arg("garment"), py::arg("body_a"), py::arg("features") = nullptr, py::arg("units") = "cm",
            py::arg("stage") = "full", py::arg("symmetry") = "auto", py::arg("collision") = true,
            py::arg("clearance") = 0.2, py::arg("threads") = 0, py::arg("metrics") = false,
-           py::arg("progress") = py::none(),
+           py::arg("progress") = py::none(), py::arg("follow_body") = 0.0,
            "The options of `refit resize` of the same names: features (or None); units cm|mm|m|in; stage "
-           "warp|features|full; symmetry auto|x|none; collision and its clearance in cm (0 to 10); threads (0 = "
+           "warp|features|full; symmetry auto|x|none; collision and its clearance in cm (0 to 10); follow_body "
+           "(--follow-body, cm, 0 to 10; 0: off); threads (0 = "
            "all cores; results do not depend on it); metrics adds fit, penetration and sanity metrics to the "
            "report; progress, if given, is called with each stage's name (str). UsageError for a value the command "
            "line refuses, InputError for bad input.")

@@ -44,6 +44,7 @@ class Job:
     symmetry: str = "auto"
     collision: bool = True
     clearance: float = 0.2
+    follow_body: float = 0.0  # refit resize --follow-body (cm; 0: off)
     threads: int = 1  # engine threads per body: one Dask task slot is one core
     metrics: bool = False
     redo: bool = False  # resize bodies whose output exists too
@@ -117,7 +118,8 @@ def _bound(job):
         features = refit.read_features(job.features, units=job.units) if job.features else None
         binding = refit.Binding(garment, refit.read_body(job.body_a), features=features, units=job.units,
                                 stage=job.stage, symmetry=job.symmetry, collision=job.collision,
-                                clearance=job.clearance, threads=job.threads, metrics=job.metrics)
+                                clearance=job.clearance, threads=job.threads, metrics=job.metrics,
+                                follow_body=job.follow_body)
         _bindings[job] = (binding, garment)
         return binding, garment, (time.perf_counter() - start) * 1000.0
 
@@ -306,6 +308,8 @@ def _parser():
     p.add_argument("--symmetry", default="auto", choices=["auto", "x", "none"])
     p.add_argument("--no-collision", action="store_true")
     p.add_argument("--clearance", type=float, default=0.2, help="collision clearance in cm (0 to 10)")
+    p.add_argument("--follow-body", type=float, default=0.0,
+                   help="feature samples that sat within this of body A (cm) follow body B (0 to 10; 0: off)")
     p.add_argument("--metrics", action="store_true", help="add the metrics of the result to each body's report")
     p.add_argument("--redo", action="store_true", help="resize bodies whose output exists too")
     p.add_argument("--quiet", action="store_true", help="no progress line")
@@ -325,9 +329,12 @@ def main(argv=None):
         p.error("--workers must be at least 1 and --threads within 0 to 1024")
     if not 0 <= a.clearance <= 10:
         p.error("--clearance: %s is outside 0 to 10 cm" % a.clearance)
+    if not 0 <= a.follow_body <= 10:
+        p.error("--follow-body: %s is outside 0 to 10 cm" % a.follow_body)
     job = Job(garment=os.path.abspath(a.garment), body_a=os.path.abspath(a.body_a),
               features=os.path.abspath(a.features) if a.features else "", units=a.units, stage=a.stage,
-              symmetry=a.symmetry, collision=not a.no_collision, clearance=a.clearance, threads=a.threads,
+              symmetry=a.symmetry, collision=not a.no_collision, clearance=a.clearance, follow_body=a.follow_body,
+              threads=a.threads,
               metrics=a.metrics, redo=a.redo)
     summary_path = a.summary or os.path.splitext(a.manifest)[0] + ".summary.json"
     try:
