@@ -134,7 +134,8 @@ class Task:
         self.features = bpy.path.abspath(features) if features else ""
         self.options = dict(units=units_of(settings), stage=settings.stage, symmetry=settings.symmetry,
                             collision=settings.collision, threads=settings.threads,
-                            clearance=round(settings.clearance, 6))  # Blender keeps float32: 0.2 is 0.2000000030
+                            clearance=round(settings.clearance, 6),  # Blender keeps float32: 0.2 is 0.2000000030
+                            follow_body=round(settings.follow_body, 6))
         self.result = None
 
     def run(self, refit, progress):
@@ -221,6 +222,9 @@ class RefitSettings(bpy.types.PropertyGroup):
         ("x", "X", "Always about x"), ("none", "None", "Never")])
     collision: BoolProperty(name="Collision", default=True, description="Push the garment out of body B")
     clearance: FloatProperty(name="Clearance (cm)", default=0.2, min=0.0, max=10.0)
+    follow_body: FloatProperty(name="Follow body (cm)", default=0.0, min=0.0, max=10.0,
+                               description="Feature samples that sat within this of body A follow body B "
+                                           "(a fitted part; 0: the curves keep their shape there too)")
     threads: IntProperty(name="Threads", default=0, min=0, max=1024, description="0: every core")
 
 
@@ -329,6 +333,7 @@ class VIEW3D_PT_refit(bpy.types.Panel):
         row = col.row()
         row.prop(s, "collision")
         row.prop(s, "clearance")
+        col.prop(s, "follow_body")
         col.prop(s, "threads")
         col.operator(REFIT_OT_resize.bl_idname, icon="MOD_CLOTH")
 
