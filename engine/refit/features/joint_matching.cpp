@@ -467,14 +467,17 @@ FeatureResult match_shapes_jointly(const ShapeModel& model, const std::vector<Po
     r.plane.point += sys.offset(k) * r.plane.normal;
     r.optimised.resize(Eigen::Index(m), 3);
     for (std::size_t i = 0; i < m; ++i) r.optimised.row(Eigen::Index(i)) = sys.eval(expr[k][i]).transpose();
-    for (std::size_t i = 0; i < m && clear; ++i)
-      if (expr[k][i].terms.size() == 1 && expr[k][i].terms[0].second == 1.0 && !crossing[k][i] &&
-          moved_by[expr[k][i].terms[0].first].squaredNorm() > 0.0)
-        r.cleared.push_back({Index(i), "clearance", moved_by[expr[k][i].terms[0].first].norm()});
-    for (std::size_t i = 0; i < m && !pulled_by.empty(); ++i)
-      if (expr[k][i].terms.size() == 1 && expr[k][i].terms[0].second == 1.0 && !crossing[k][i] &&
-          pulled_by[expr[k][i].terms[0].first].squaredNorm() > 0.0)
-        r.followed.push_back({Index(i), "follow", pulled_by[expr[k][i].terms[0].first].norm()});
+    // The curve's own samples (not crossings) that a step moved, and how far.
+    const auto moved_samples = [&](const std::vector<Vec3>& per_slot, const char* reason) {
+      std::vector<FixedSample> out;
+      for (std::size_t i = 0; i < m && !per_slot.empty(); ++i)
+        if (expr[k][i].terms.size() == 1 && expr[k][i].terms[0].second == 1.0 && !crossing[k][i] &&
+            per_slot[expr[k][i].terms[0].first].squaredNorm() > 0.0)
+          out.push_back({Index(i), reason, per_slot[expr[k][i].terms[0].first].norm()});
+      return out;
+    };
+    r.cleared = moved_samples(moved_by, "clearance");
+    r.followed = moved_samples(pulled_by, "follow");
     Coords xw(Eigen::Index(m), 2), x(Eigen::Index(m), 2);
     for (std::size_t i = 0; i < m; ++i) {
       xw.row(Eigen::Index(i)) = r.plane.to_2d(row3(r.warped, Index(i))).transpose();
