@@ -17,7 +17,7 @@ TEST(SpatialOrder, IsAPermutationAlongTheCurve) {
   for (Eigen::Index i = 0; i < p.rows(); ++i) p.row(i) << u(rng), u(rng), u(rng);
   p.row(17) << std::nan(""), 0, 0;
   const CurveOrder c = curve_order(p);
-  std::vector<Index> sorted = c.order;
+  std::vector<Index> sorted(c.order.begin(), c.order.end());
   std::sort(sorted.begin(), sorted.end());
   for (std::size_t i = 0; i < sorted.size(); ++i) ASSERT_EQ(sorted[i], i);
   EXPECT_TRUE(std::is_sorted(c.key.begin(), c.key.end()));

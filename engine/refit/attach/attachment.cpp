@@ -16,12 +16,12 @@ namespace {
 
 // Every element of the garment once: fan triangles of the faces, segments of the
 // `l` polylines, the vertices of `p` elements.
-std::vector<detail::Element> garment_elements(const Garment& g) {
+UninitVector<detail::Element> garment_elements(const Garment& g) {
   // Face f's fan triangles start at first[f] (filled in parallel: a million faces).
   const std::size_t nf = g.faces.rows();
   std::vector<std::size_t> first(nf + 1, 0);
   for (std::size_t f = 0; f < nf; ++f) first[f + 1] = first[f] + std::max<std::size_t>(g.faces.row(f).size(), 2) - 2;
-  std::vector<detail::Element> out(first[nf]);
+  UninitVector<detail::Element> out(first[nf]);  // every one set below
   parallel_for(0, nf, 4096, [&](std::size_t b, std::size_t e) {
     for (std::size_t f = b; f < e; ++f) {
       const auto face = g.faces.row(f);
@@ -68,7 +68,7 @@ SurfaceAttachment GarmentLocator::attach(const Points& samples) const {
   // Work grows with the samples and the garment, not with their product. The
   // samples go in space-filling-curve order: consecutive queries walk the same
   // branches of the tree.
-  const std::vector<Index> order = spatial_order(samples);
+  const UninitVector<Index> order = spatial_order(samples);
   parallel_for(0, n, 256, [&](std::size_t sb, std::size_t se) {
     std::size_t hint = ElementIndex::kNoHint;  // the previous query's element: a bound to start from
     for (std::size_t k = sb; k < se; ++k) {

@@ -14,8 +14,8 @@ namespace refit {
 /// bounding box, ties by row, and their 63-bit keys in that order (non-finite
 /// rows last, with key 2^64 - 1). Deterministic and parallel.
 struct CurveOrder {
-  std::vector<Index> order;
-  std::vector<std::uint64_t> key;  // key[k]: the key of row order[k] (ascending)
+  UninitVector<Index> order;
+  UninitVector<std::uint64_t> key;  // key[k]: the key of row order[k] (ascending)
 };
 CurveOrder curve_order(const Points& points);
 /// The same for n points given by point(i) (no matrix of them is made).
@@ -33,6 +33,6 @@ inline std::uint64_t spread3(std::uint64_t x) {
 }
 
 /// curve_order(points).order.
-std::vector<Index> spatial_order(const Points& points);
+UninitVector<Index> spatial_order(const Points& points);
 
 }  // namespace refit
