@@ -287,5 +287,25 @@ TEST(Collision, SphereShellPartlyInsideComesOutBitIdenticalForAnyThreadCount) {
   EXPECT_THROW(resolve_penetrations(g, shifted, body, negative), Error);
 }
 
+// A caller resolving one garment on many bodies keeps its vertex adjacency: the
+// same result as the step making it itself, and one of another garment is refused.
+TEST(Collision, AGivenVertexAdjacencyGivesTheSameResult) {
+  const BodySurface body(sphere_body(3, 10.0));
+  const Garment g = sphere_garment(3, 10.4);
+  const Points shifted = g.positions.rowwise() + Eigen::RowVector3d(1.5, 0, 0);
+  Points own = shifted, given = shifted;
+  const CollisionReport r_own = resolve_penetrations(g, own, body);
+  const Csr adjacency = vertex_adjacency(g);
+  CollisionOptions with;
+  with.adjacency = &adjacency;
+  const CollisionReport r_given = resolve_penetrations(g, given, body, with);
+  EXPECT_GT(r_own.moved, 10u);
+  EXPECT_TRUE(own == given);
+  EXPECT_EQ(r_own.to_json(), r_given.to_json());
+  const Csr other = vertex_adjacency(sphere_garment(2, 10.4));
+  with.adjacency = &other;
+  EXPECT_THROW(resolve_penetrations(g, given, body, with), Error);
+}
+
 }  // namespace
 }  // namespace refit

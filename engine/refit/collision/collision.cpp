@@ -181,7 +181,10 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   // The inside test's grid, built in parallel here rather than on the first
   // inside() call of the parallel loop below (there it would run on one thread).
   body_b.prepare_inside_test();
-  const Csr adj = vertex_adjacency(g);
+  Csr own_adjacency;
+  if (!options.adjacency) own_adjacency = vertex_adjacency(g);
+  const Csr& adj = options.adjacency ? *options.adjacency : own_adjacency;
+  if (adj.rows() != n) throw Error("penetration resolution: the vertex adjacency does not match the garment");
 
   // Remembers where a vertex started before the step first moves it.
   const auto touch = [&](Index i) {

@@ -43,6 +43,10 @@ struct CollisionOptions {
   /// the rounds then run again over those vertices, so what it leaves too close
   /// is pushed out by what it still needs.
   std::function<std::vector<std::pair<Index, Vec3>>(const Points& positions)> symmetrise;
+  /// Optional: the garment's vertex_adjacency (core/topology.hpp), for a caller
+  /// that resolves one garment on many bodies (on a 1M garment it takes 0.1 s
+  /// to make); null: made here.
+  const Csr* adjacency = nullptr;
 };
 
 struct CollisionReport {

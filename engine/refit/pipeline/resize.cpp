@@ -4,6 +4,7 @@
 #include <refit/features/curve_metrics.hpp>
 #include <refit/features/feature_curves.hpp>
 #include <refit/collision/collision.hpp>
+#include <refit/core/topology.hpp>
 #include <refit/io/obj_garment.hpp>
 #include <refit/metrics/metrics.hpp>
 #include <refit/pipeline/resize.hpp>
@@ -244,6 +245,11 @@ bool GarmentBinding::body_b_symmetric(const BodyMesh& body_b, nlohmann::json& re
   return symmetric_b;
 }
 
+const Csr& GarmentBinding::vertex_adjacency_once() const {
+  std::call_once(adjacency_once_, [&] { adjacency_ = vertex_adjacency(*garment_); });
+  return adjacency_;
+}
+
 // A symmetric pair gives a symmetric garment: each paired vertex halfway to its partner's mirror image.
 void GarmentBinding::symmetrise_garment(Points& positions) const {
   const Points mirrored = mirror_x(carry(garment_mirror_, positions), mirror_x_);
@@ -351,6 +357,7 @@ void GarmentBinding::collision_step(const BodySurface& surface_b, bool symmetric
     co.symmetrise = [&](const Points& now) {
       return symmetric_pushes(before, now, kSymmetricPushToleranceCm * per_cm, co.max_lift);
     };
+  co.adjacency = &vertex_adjacency_once();
   const CollisionReport c = resolve_penetrations(*garment_, result.positions, surface_b, co);
   result.report["timings_ms"]["collision"] = clock.ms();
   result.report["collision"] = c.to_json();

@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <utility>
@@ -102,6 +103,7 @@ class GarmentBinding {
                                                       double max_extra) const;
   void metrics_step(const BodySurface& surface_b, ResizeResult& result, const Progress& progress) const;
   void symmetrise_garment(Points& positions) const;
+  const Csr& vertex_adjacency_once() const;
 
   std::shared_ptr<const Garment> garment_;
   ResizeOptions options_;
@@ -118,6 +120,10 @@ class GarmentBinding {
   SurfaceAttachment feature_attachment_;  // where the feature samples (all curves, in order) sit on the garment
   nlohmann::json bind_report_;
   double memory_estimate_mb_ = 0.0;
+  // The collision step's vertex adjacency: made by the first resize that needs
+  // it (so a single body's peak memory is as before), kept for the next bodies.
+  mutable std::once_flag adjacency_once_;
+  mutable Csr adjacency_;
 };
 
 /// The surface step's options in garment units: `options.surface` keeps epsilon
