@@ -116,4 +116,43 @@ TEST(Attach, ClosestElementMatchesAScanOfEveryElement) {
   EXPECT_NEAR(at.weight[0][2], 1.0, 1e-12);
 }
 
+// The locator keeps two triangle faces that share an edge in one element of
+// its tree: what it finds is still what a scan of the triangles in face order
+// finds (the first of equally close ones), whichever faces it pairs.
+TEST(Attach, TriangleFacesAttachAsAScanOfThemFinds) {
+  Garment g;
+  const int n = 24;
+  std::vector<Vec3> v;
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j) v.push_back({0.5 * i, 0.5 * j, 0.2 * std::sin(0.6 * i) * std::cos(0.4 * j)});
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const Index a = Index((n + 1) * i + j), b = a + 1, c = a + Index(n + 1), d = c + 1;
+      if ((i * n + j) % 17 == 5) g.faces.push_row(std::array<Index, 3>{0, Index(n), Index((n + 1) * n)});  // a stray: the pairs shift
+      g.faces.push_row(std::array<Index, 3>{a, c, d});
+      g.faces.push_row(std::array<Index, 3>{a, d, b});
+    }
+  g.positions.resize(Eigen::Index(v.size()), 3);
+  for (std::size_t i = 0; i < v.size(); ++i) g.positions.row(Eigen::Index(i)) = v[i].transpose();
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 13.0);
+  Points samples(1500, 3);
+  for (Eigen::Index s = 0; s < samples.rows(); ++s) samples.row(s) << u(rng), u(rng), 0.1 * u(rng);
+  for (Eigen::Index s = 0; s < 100; ++s) samples.row(s) = g.positions.row(s * 7 % g.positions.rows());  // on vertices: ties
+  const SurfaceAttachment at = attach_points(g, samples);
+  for (Eigen::Index s = 0; s < samples.rows(); ++s) {
+    const Vec3 p = samples.row(s).transpose();
+    double best = std::numeric_limits<double>::infinity();
+    std::array<Index, 3> want{};
+    for (std::size_t f = 0; f < g.faces.rows(); ++f) {
+      const auto r = g.faces.row(f);
+      const double d2 = (p - closest_point_on_triangle(p, row3(g.positions, r[0]), row3(g.positions, r[1]),
+                                                       row3(g.positions, r[2]))).squaredNorm();
+      if (d2 < best) best = d2, want = {r[0], r[1], r[2]};
+    }
+    ASSERT_EQ(at.vertex[std::size_t(s)], want) << "sample " << s;
+    ASSERT_NEAR(at.offset.row(s).squaredNorm(), best, 1e-12 * (1.0 + best)) << "sample " << s;
+  }
+}
+
 }  // namespace refit

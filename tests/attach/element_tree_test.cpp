@@ -24,7 +24,8 @@ ElementPoint scan(const std::vector<Element>& elements, const Points& x, const V
 }
 
 TEST(ElementTree, FindsWhatAScanFinds) {
-  // A bumpy 60 x 60 grid of triangles (1 cm), a copy of some of them (a soup's
+  // A bumpy 60 x 60 grid of triangles (1 cm), a third of its cells as one
+  // two-triangle element (a quad), a copy of some triangles (a soup's
   // duplicates: ties), hanging segments, loose points and a degenerate triangle.
   const int n = 60;
   Points x((n + 1) * (n + 1) + 3, 3);
@@ -38,6 +39,10 @@ TEST(ElementTree, FindsWhatAScanFinds) {
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) {
       const Index a = Index(i * (n + 1) + j), b = a + 1, c = a + Index(n + 1), d = c + 1;
+      if ((i + j) % 3 == 1) {
+        elements.push_back({{a, c, d, a, d, b}, 6});  // (a, c, d) then (a, d, b)
+        continue;
+      }
       elements.push_back({{a, c, d}, 3});
       elements.push_back({{a, d, b}, 3});
       if ((i + j) % 7 == 0) elements.push_back({{a, d, b}, 3});  // duplicate: the first must win
@@ -92,7 +97,8 @@ TEST(ElementTree, FindsWhatAScanFindsInRandomSoups) {
   // them degenerate (a repeated corner, three collinear corners, a needle),
   // copies of earlier triangles under their own vertex numbers (equally close,
   // different answers: the first must win) and under the same ones, segments
-  // (some of zero length) and points. One soup sits 10 km from the origin,
+  // (some of zero length), points and two-triangle elements (bent, and with a
+  // repeated corner). One soup sits 10 km from the origin,
   // where float boxes are coarse against the elements.
   for (const double origin : {0.0, 1e6}) {
     std::mt19937 rng(origin == 0.0 ? 11 : 12);
@@ -115,12 +121,28 @@ TEST(ElementTree, FindsWhatAScanFindsInRandomSoups) {
         case 3: elements.push_back({{a, vertex(c + d1), vertex(c + d1)}, 2}); break;     // a segment
         case 4: elements.push_back({{a, a, a}, 2}); break;                              // a segment of length 0
         case 5: elements.push_back({{a, a, a}, 1}); break;                              // a point
+        case 7: {  // two triangles, bent along their shared edge
+          const Index b = vertex(c + d1), cc = vertex(c + d1 + d2 + 0.3 * d1.cross(d2) / (d1.norm() + 1e-30)),
+                      d = vertex(c + d2);
+          elements.push_back({{a, b, cc, a, cc, d}, 6});
+          break;
+        }
+        case 8: {  // the first one degenerate (a repeated corner)
+          const Index b = vertex(c + d1), d = vertex(c + d2);
+          elements.push_back({{a, a, b, a, d, b}, 6});
+          break;
+        }
+        case 9: {  // two triangles far apart (an element's triangles need not meet)
+          const Index b = vertex(c + d1), cc = vertex(c + d2), far = vertex(-c);
+          elements.push_back({{a, b, cc, far, vertex(-c + d1), vertex(-c + d2)}, 6});
+          break;
+        }
         case 6:
           if (!elements.empty()) {  // an earlier element again: its own vertices, then copies of them
             const Element e = elements[std::size_t(unit(rng) * double(elements.size()))];
             elements.push_back(e);
             Element copy = e;
-            for (int k = 0; k < 3; ++k) copy.v[k] = vertex(v[e.v[k]] - Vec3::Constant(origin));
+            for (int k = 0; k < (e.corners == 6 ? 6 : 3); ++k) copy.v[k] = vertex(v[e.v[k]] - Vec3::Constant(origin));
             elements.push_back(copy);
             break;
           }
@@ -147,8 +169,8 @@ TEST(ElementTree, FindsWhatAScanFindsInRandomSoups) {
 }
 
 TEST(ElementTree, FindsWhatAScanFindsOnFineTubes) {
-  // Real-like without the shared data: a garment's fine tube (5 mm triangles)
-  // around a body's, both a few mm apart, queried at mirror images of its
+  // Real-like without the shared data: a garment's fine tube (5 mm triangles,
+  // the outer one as quads) around a body's, both a few mm apart, queried at mirror images of its
   // vertices (the symmetry binding's queries), at the vertices themselves and
   // just off the surface.
   const int around = 120, along = 40;
@@ -164,6 +186,10 @@ TEST(ElementTree, FindsWhatAScanFindsOnFineTubes) {
     for (int j = 0; j + 1 < along; ++j)
       for (int i = 0; i < around; ++i) {
         const auto id = [&](int jj, int ii) { return Index((layer * along + jj) * around + (ii % around)); };
+        if (layer == 1) {
+          elements.push_back({{id(j, i), id(j + 1, i), id(j + 1, i + 1), id(j, i), id(j + 1, i + 1), id(j, i + 1)}, 6});
+          continue;
+        }
         elements.push_back({{id(j, i), id(j + 1, i), id(j + 1, i + 1)}, 3});
         elements.push_back({{id(j, i), id(j + 1, i + 1), id(j, i + 1)}, 3});
       }

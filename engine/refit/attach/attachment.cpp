@@ -14,18 +14,49 @@ namespace refit {
 
 namespace {
 
-// Every element of the garment once: fan triangles of the faces, segments of the
-// `l` polylines, the vertices of `p` elements.
+// Every element of the garment once: the fan triangles of the faces, two to
+// an element where they share an edge (a quad's two; triangle faces 2j and
+// 2j + 1, as a triangulated quad mesh lists them), segments of the `l`
+// polylines, the vertices of `p` elements. In this order the triangles come as
+// the faces and their fans list them (a scan's order: the first of equally
+// close triangles is the one the locator returns).
 UninitVector<detail::Element> garment_elements(const Garment& g) {
-  // Face f's fan triangles start at first[f] (filled in parallel: a million faces).
   const std::size_t nf = g.faces.rows();
+  const auto shares_an_edge = [&](std::size_t f) {  // triangle faces f and f + 1
+    if (f + 1 >= nf || g.faces.row_size(f) != 3 || g.faces.row_size(f + 1) != 3) return false;
+    const auto a = g.faces.row(f), b = g.faces.row(f + 1);
+    int common = 0;
+    for (Index v : a) common += int(std::count(b.begin(), b.end(), v));
+    return common >= 2;
+  };
+  // Face f's elements start at first[f] (filled in parallel: a million faces).
+  const auto elements_of = [&](std::size_t f) -> std::size_t {
+    const std::size_t m = g.faces.row_size(f);
+    if (m != 3) return (std::max<std::size_t>(m, 2) - 1) / 2;
+    if (f % 2 == 1 && shares_an_edge(f - 1)) return 0;  // the second of a pair
+    return 1;
+  };
   std::vector<std::size_t> first(nf + 1, 0);
-  for (std::size_t f = 0; f < nf; ++f) first[f + 1] = first[f] + std::max<std::size_t>(g.faces.row(f).size(), 2) - 2;
+  for (std::size_t f = 0; f < nf; ++f) first[f + 1] = first[f] + elements_of(f);
   UninitVector<detail::Element> out(first[nf]);  // every one set below
   parallel_for(0, nf, 4096, [&](std::size_t b, std::size_t e) {
     for (std::size_t f = b; f < e; ++f) {
       const auto face = g.faces.row(f);
-      for (std::size_t k = 1; k + 1 < face.size(); ++k) out[first[f] + k - 1] = {{face[0], face[k], face[k + 1]}, 3};
+      if (face.size() == 3) {
+        if (first[f + 1] == first[f]) continue;  // the second of a pair
+        if (f % 2 == 0 && shares_an_edge(f)) {
+          const auto next = g.faces.row(f + 1);
+          out[first[f]] = {{face[0], face[1], face[2], next[0], next[1], next[2]}, 6};
+        } else {
+          out[first[f]] = {{face[0], face[1], face[2]}, 3};
+        }
+        continue;
+      }
+      // Fan triangles (face[0], face[k], face[k + 1]), k = 1 .. size - 2, two at a time.
+      for (std::size_t k = 1, j = first[f]; k + 1 < face.size(); k += 2, ++j)
+        out[j] = k + 2 < face.size()
+                     ? detail::Element{{face[0], face[k], face[k + 1], face[0], face[k + 1], face[k + 2]}, 6}
+                     : detail::Element{{face[0], face[k], face[k + 1]}, 3};
     }
   });
   out.reserve(out.size() + g.lines.indices.size() + g.points.indices.size());

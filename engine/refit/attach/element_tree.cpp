@@ -34,8 +34,18 @@ float float_above(double v) {
   return double(f) < v ? float_step(f, true) : f;
 }
 
-// The closest point of p on element e, and its barycentric weights on e's
-// corners (computed for the winner only: the same arithmetic either way).
+// A two-triangle element's triangle `sub` (0 or 1); any other element itself.
+Element part(const Element& e, int sub) {
+  if (e.corners != 6) return e;
+  const std::size_t o = sub == 0 ? 0 : 3;
+  return Element{{e.v[o], e.v[o + 1], e.v[o + 2]}, 3};
+}
+int parts(const Element& e) { return e.corners == 6 ? 2 : 1; }
+// The entries of e.v in use (a segment's or a point's repeat their last corner to the third).
+int used(const Element& e) { return e.corners == 6 ? 6 : 3; }
+
+// The closest point of p on element e (at most 3 corners), and its barycentric
+// weights on e's corners (computed for the winner only: the same arithmetic either way).
 Vec3 closest_point(const Vec3& p, const Points& x, const Element& e) {
   const Vec3 a = row3(x, e.v[0]);
   if (e.corners == 1) return a;
@@ -65,7 +75,7 @@ ElementPoint with_weights(const Vec3& p, const Points& x, const Element& e, cons
     const double den = d00 * d11 - d01 * d01;
     const double wv = den != 0.0 ? (d11 * d20 - d01 * d21) / den : 0.0;
     const double ww = den != 0.0 ? (d00 * d21 - d01 * d20) / den : 0.0;
-    c = {0.0, e.v, {1.0 - wv - ww, wv, ww}, q};
+    c = {0.0, {e.v[0], e.v[1], e.v[2]}, {1.0 - wv - ww, wv, ww}, q};
   }
   c.d2 = (c.point - p).squaredNorm();
   return c;
@@ -74,7 +84,16 @@ ElementPoint with_weights(const Vec3& p, const Points& x, const Element& e, cons
 }  // namespace
 
 ElementPoint closest_on_element(const Vec3& p, const Points& x, const Element& e) {
-  return with_weights(p, x, e, closest_point(p, x, e));
+  const Element first = part(e, 0);
+  ElementPoint best = with_weights(p, x, first, closest_point(p, x, first));
+  if (parts(e) == 2) {
+    // The second only when closer, or when the first has no distance (a
+    // degenerate triangle's NaN, which the tree skips as a scan does).
+    const Element second = part(e, 1);
+    const ElementPoint c = with_weights(p, x, second, closest_point(p, x, second));
+    if (c.d2 < best.d2 || (std::isnan(best.d2) && !std::isnan(c.d2))) best = c;
+  }
+  return best;
 }
 
 void ElementTree::Box::grow(const Box& o) {
@@ -83,21 +102,27 @@ void ElementTree::Box::grow(const Box& o) {
 
 ElementTree::Box ElementTree::box_of(const Element& e) const {
   Vec3 lo = row3(x_, e.v[0]), hi = lo;
-  for (int k = 1; k < 3; ++k) lo = lo.cwiseMin(row3(x_, e.v[k])), hi = hi.cwiseMax(row3(x_, e.v[k]));
+  for (int k = 1; k < used(e); ++k) lo = lo.cwiseMin(row3(x_, e.v[k])), hi = hi.cwiseMax(row3(x_, e.v[k]));
   Box b;
   for (int k = 0; k < 3; ++k) b.lo[k] = float_below(lo[k]), b.hi[k] = float_above(hi[k]);
   return b;
 }
 
 ElementTree::Disc ElementTree::disc_of(const Element& e) const {
-  const Vec3 a = row3(x_, e.v[0]), b = row3(x_, e.v[1]), c = row3(x_, e.v[2]);
-  const Vec3 g = e.corners == 3 ? Vec3((a + b + c) / 3.0) : Vec3(0.5 * (a + b));
-  Vec3 n = Vec3::Zero();
-  if (e.corners == 3) {
-    const Vec3 normal = (b - a).cross(c - a);
-    const double len = normal.norm();
-    if (len > 0.0 && std::isfinite(len)) n = normal / len;  // else a ball about g
+  std::array<Vec3, 6> corner;
+  for (int k = 0; k < used(e); ++k) corner[std::size_t(k)] = row3(x_, e.v[std::size_t(k)]);
+  const Vec3 &a = corner[0], &b = corner[1], &c = corner[2];
+  Vec3 g = Vec3(0.5 * (a + b)), normal = Vec3::Zero();
+  if (e.corners == 3) g = (a + b + c) / 3.0, normal = (b - a).cross(c - a);
+  if (e.corners == 6) {
+    const Vec3 &d = corner[3], &f = corner[4], &h = corner[5];
+    g = (a + b + c + d + f + h) / 6.0;
+    const Vec3 n0 = (b - a).cross(c - a), n1 = (f - d).cross(h - d);
+    normal = n0.dot(n1) >= 0.0 ? Vec3(n0 + n1) : Vec3(n0 - n1);  // the two sides as one, whichever way each turns
   }
+  Vec3 n = Vec3::Zero();
+  const double len = normal.norm();
+  if (len > 0.0 && std::isfinite(len)) n = normal / len;  // else a ball about g
   Disc d;
   for (int k = 0; k < 3; ++k) d.n[k] = float(n[k]), d.g[k] = float(g[k]);
   // The slab's half thickness and the radius, measured from the float n and g
@@ -105,7 +130,11 @@ ElementTree::Disc ElementTree::disc_of(const Element& e) const {
   // not perpendicular to it, and then the slab is as thick as the triangle.
   const Vec3 nf(d.n[0], d.n[1], d.n[2]), gf(d.g[0], d.g[1], d.g[2]);
   double thick = 0.0, r = 0.0;
-  for (const Vec3& v : {a, b, c}) thick = std::max(thick, std::abs(nf.dot(v - gf))), r = std::max(r, (v - gf).norm());
+  for (int k = 0; k < used(e); ++k) {
+    const Vec3& v = corner[std::size_t(k)];
+    thick = std::max(thick, std::abs(nf.dot(v - gf)));
+    r = std::max(r, (v - gf).norm());
+  }
   d.thick = float_above(thick);
   d.r = float_above(r);
   return d;
@@ -135,7 +164,7 @@ ElementTree::ElementTree(std::span<const Element> elements, const Points& x) : x
   const CurveOrder curve = curve_order(n, [&](std::size_t i) {
     const Element& e = elements[i];
     Vec3 lo = row3(x_, e.v[0]), hi = lo;
-    for (int k = 1; k < 3; ++k) lo = lo.cwiseMin(row3(x_, e.v[k])), hi = hi.cwiseMax(row3(x_, e.v[k]));
+    for (int k = 1; k < used(e); ++k) lo = lo.cwiseMin(row3(x_, e.v[k])), hi = hi.cwiseMax(row3(x_, e.v[k]));
     return Vec3(0.5 * (lo + hi));
   });
   elements_.resize(n);
@@ -223,21 +252,26 @@ ElementTree::Ref ElementTree::build(const UninitVector<std::uint64_t>& key, std:
 ElementPoint ElementTree::closest(const Vec3& p, std::size_t& hint) const {
   ElementPoint best;
   if (elements_.empty() || !p.allFinite()) return best;
-  Index best_id = std::numeric_limits<Index>::max();
+  std::uint64_t best_key = std::numeric_limits<std::uint64_t>::max();
   // Culling, in float against p rounded to float: a box or disc farther than
   // the best so far plus what the rounding of p and of float arithmetic can
   // hide. No element as close as the best is ever left out.
   const double slack = 2e-7 * p.cwiseAbs().maxCoeff();
   float limit2 = kFloatInf;
   const auto take = [&](std::size_t k) {
-    const Vec3 q = closest_point(p, x_, elements_[k]);
-    const double d2 = (q - p).squaredNorm();
-    if (!(d2 < best.d2 || (d2 == best.d2 && id_[k] < best_id))) return;
-    best = with_weights(p, x_, elements_[k], q);
-    best_id = id_[k];
-    hint = k;
-    const double reach = std::sqrt(best.d2) * (1.0 + 1e-9) + slack;
-    limit2 = float_above(reach * reach * (1.0 + 1e-6));
+    const Element& e = elements_[k];
+    for (int sub = 0; sub < parts(e); ++sub) {
+      const Element t = part(e, sub);
+      const Vec3 q = closest_point(p, x_, t);
+      const double d2 = (q - p).squaredNorm();
+      const std::uint64_t key = std::uint64_t(id_[k]) * 2 + std::uint64_t(sub);  // a scan's order of the triangles
+      if (!(d2 < best.d2 || (d2 == best.d2 && key < best_key))) continue;
+      best = with_weights(p, x_, t, q);
+      best_key = key;
+      hint = k;
+      const double reach = std::sqrt(best.d2) * (1.0 + 1e-9) + slack;
+      limit2 = float_above(reach * reach * (1.0 + 1e-6));
+    }
   };
   if (hint < elements_.size()) take(hint);
 

@@ -20,22 +20,28 @@ struct ElementPoint {
   Vec3 point = Vec3::Zero();
 };
 
-/// An element: a triangle (3 corners), a segment (2: v[2] == v[1]) or a point (1).
+/// An element: two triangles (corners 6: (v0, v1, v2) then (v3, v4, v5), such
+/// as a quad's two fan triangles or two triangle faces that share an edge), a
+/// triangle (3), a segment (2: v[2] == v[1]) or a point (1). Two triangles to an
+/// element halve the tree of a fine mesh (its build and its depth); the closest
+/// point is still a triangle's, the first of the two when equally close.
 struct Element {
-  std::array<Index, 3> v;
+  std::array<Index, 6> v;
   int corners;
 };
 
-/// Closest point of p on element `e` over the positions `x`.
+/// Closest point of p on element `e` over the positions `x` (of its first
+/// triangle when both of a two-triangle element's are as close).
 ElementPoint closest_on_element(const Vec3& p, const Points& x, const Element& e);
 
 /// Elements sorted along a space-filling curve, split where their curve keys
 /// first differ (a spatial split, as in Karras' linear BVH), in nodes of four
 /// children whose boxes are kept in the parent (one node read tests four
 /// boxes) and leaves of a few elements, each with a bound of its own: for a
-/// triangle the disc in its plane that holds it, as thick as the rounding of
-/// its normal needs (tight for points well off a finely meshed surface, where
-/// boxes of tilted triangles are not), else a ball.
+/// triangle (or two) the disc in its plane that holds it, as thick as the
+/// rounding of its normal (or the two triangles' bend) needs (tight for points
+/// well off a finely meshed surface, where boxes of tilted triangles are not),
+/// else a ball.
 /// A query descends nearer children first, so its best distance drops at once
 /// and every box or disc farther than that is skipped. Keeps a reference to `x`.
 class ElementTree {
