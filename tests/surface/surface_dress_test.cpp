@@ -384,6 +384,44 @@ TEST(SurfaceDress, SameBodyGivesTheInputBackAndThreadsDoNotMatter) {
   EXPECT_EQ(std::memcmp(one.result.data(), two.result.data(), sizeof(double) * one.result.size()), 0);
 }
 
+// Eq. 14 for the vertices asks whether each is within epsilon of body B or
+// inside it; apply(..., body_b) answers with a query of radius epsilon
+// (near_body), and must answer as body_distance(p) < epsilon does.
+TEST(SurfaceDress, TheNearBodyTestIsTheBodyDistanceUnderEpsilon) {
+  const mq::BodyParams a{};
+  mq::BodyParams b = a;
+  b.belly = 8;
+  b.hip = a.hip + 6;
+  mq::GarmentParams gp;
+  gp.kind = mq::GarmentParams::Kind::Dress;
+  gp.target_vertices = 3000;
+  gp.ease = -0.5;
+  const Garment dress = mq::make_garment(a, gp);
+  const BodyMesh body_b = mq::make_body(b);
+  const BodySurface surface_b(body_b);
+  const SurfaceBinding sb = SurfaceBinding::bind(dress, Points(0, 3), SurfaceOptions{});
+  const auto distance = sb.body_distance(surface_b);
+  const NearBody near = sb.near_body(surface_b);
+  const double eps = SurfaceOptions{}.epsilon;
+  // The dress's vertices, body B's vertices moved along their normal by -1.5 to
+  // 1.5 epsilon (inside, on, just under and just over epsilon) and far points.
+  std::vector<Vec3> points;
+  for (Eigen::Index v = 0; v < dress.positions.rows(); ++v) points.push_back(row3(dress.positions, Index(v)));
+  for (Eigen::Index v = 0; v < body_b.vertices.rows(); v += 7) {
+    const Vec3 p = row3(body_b.vertices, Index(v));
+    const Vec3 n = surface_b.closest(p + Vec3(0, 0, 1e-9)).normal;
+    for (const double t : {-1.5, -0.5, 0.0, 0.5, 0.999, 1.0, 1.001, 1.5}) points.push_back(p + t * eps * n);
+  }
+  points.push_back(Vec3(0, 300, 0));
+  std::size_t near_count = 0;
+  for (const Vec3& p : points) {
+    ASSERT_EQ(near(p), distance(p) < eps) << p.transpose();
+    near_count += near(p);
+  }
+  EXPECT_GT(near_count, points.size() / 4);
+  EXPECT_LT(near_count, points.size());
+}
+
 TEST(SurfaceDress, MultigridCyclesReachThePlainSweepsFixedPointInFarFewerSweeps) {
   // V-cycles (aggregation coarse levels) against the paper's plain sweeps run
   // until they converge: the same fixed point, in a fraction of the sweeps.

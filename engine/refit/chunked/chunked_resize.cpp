@@ -262,6 +262,7 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
       Points at_agents;
       PointGather(warped, 0).gather(agent_vertices, at_agents);
       const auto distance = surface.body_distance(surface_b);
+      const NearBody near = surface.near_body(surface_b);
       SurfaceBinding::AgentSolution sol =
           surface.solve_agents(surface.agent_positions(at_agents, agent_vertices, &feature_warped), feature_targets,
                                distance, nullptr);
@@ -301,7 +302,7 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
           for (auto it = lo; it != bound_->carries_feature.end() && *it < first + carries.size(); ++it) carries[*it - first] = 1;
         }
         std::vector<std::uint8_t> kept;
-        const Points s = surface.emit_vertices(sol, original, w, blends, carries, distance, kept, st);
+        const Points s = surface.emit_vertices(sol, original, w, blends, carries, near, kept, st);
         surfaced->write(first, s);
         if (!snaps) return;
         const auto held = [&](std::size_t i) { return !kept.empty() && kept[i]; };

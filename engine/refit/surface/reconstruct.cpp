@@ -181,7 +181,7 @@ std::vector<Eigen::Matrix3d> SurfaceBinding::rotations(const Points& before, con
 
 Points SurfaceBinding::emit_vertices(const AgentSolution& sol, const Points& original, const Points& warped,
                                      const VertexBlends& blends, std::span<const std::uint8_t> carries_feature,
-                                     const std::function<double(const Vec3&)>& distance, std::vector<std::uint8_t>& kept,
+                                     const NearBody& near_body_b, std::vector<std::uint8_t>& kept,
                                      SurfaceStats& stats) const {
   kept.clear();
   if (agent_count() == 0) return warped;
@@ -189,7 +189,7 @@ Points SurfaceBinding::emit_vertices(const AgentSolution& sol, const Points& ori
   Points out = reconstruct_rotations(orig ? original : warped, orig ? original_agents_ : sol.before, sol.x, sol.rotation,
                                      blends.reach, blends.weight, blends.nearest, sol.keep, &warped);
   if (options_.keep_near_vertices) {
-    kept = keep_near_vertices(sol, warped, blends, carries_feature, distance, out);
+    kept = keep_near_vertices(sol, warped, blends, carries_feature, near_body_b, out);
     stats.vertices_kept += std::accumulate(kept.begin(), kept.end(), std::size_t{0});
   }
   return out;
@@ -201,7 +201,7 @@ Points SurfaceBinding::emit_vertices(const AgentSolution& sol, const Points& ori
 std::vector<std::uint8_t> SurfaceBinding::keep_near_vertices(const AgentSolution& sol, const Points& warped,
                                                              const VertexBlends& blends,
                                                              std::span<const std::uint8_t> carries_feature,
-                                                             const std::function<double(const Vec3&)>& distance,
+                                                             const NearBody& near_body_b,
                                                              Points& positions) const {
   const std::size_t nv = static_cast<std::size_t>(warped.rows());
   const Points& before = sol.before;
@@ -213,7 +213,7 @@ std::vector<std::uint8_t> SurfaceBinding::keep_near_vertices(const AgentSolution
       if (!near_feature_.empty() && (near_feature_[a] || carries_feature[v])) continue;
       const Vec3 p = row3(warped, Index(v));
       if (feature_of_[a] < 0 && body_distance[a] - (p - row3(before, a)).norm() >= options_.epsilon) continue;
-      if (distance(p) < options_.epsilon) {
+      if (near_body_b(p)) {
         positions.row(Eigen::Index(v)) = warped.row(Eigen::Index(v));
         kept[v] = 1;
       }

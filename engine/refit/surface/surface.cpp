@@ -168,6 +168,13 @@ Points SurfaceBinding::coarse_to_fine_start(const Points& before, const Points& 
 SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
                                     const std::function<double(const Vec3&)>& distance, const Points* fwarped,
                                     SurfaceSystem* system) const {
+  const NearBody near = [&](const Vec3& p) { return distance(p) < options_.epsilon; };
+  return apply(warped, targets, distance, near, fwarped, system);
+}
+
+SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
+                                    const std::function<double(const Vec3&)>& distance, const NearBody& near,
+                                    const Points* fwarped, SurfaceSystem* system) const {
   const std::size_t nf = feature_count();
   if (static_cast<std::size_t>(warped.rows()) != vertex_count_)
     throw Error("surface: the warped garment has " + std::to_string(warped.rows()) + " vertices, the binding expects " +
@@ -189,7 +196,7 @@ SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
   SurfaceStats& st = res.stats;
   clock.reset();
   std::vector<std::uint8_t> kept_vertex;
-  res.positions = emit_vertices(sol, original_vertices_, warped, blends_, carries_feature_, distance, kept_vertex, st);
+  res.positions = emit_vertices(sol, original_vertices_, warped, blends_, carries_feature_, near, kept_vertex, st);
   const FeatureSnapReport snapped = snap(res.positions, targets, kept_vertex);
   st.feature_gap_before_snap = snapped.gap_before;
   st.feature_gap = snapped.gap_after;

@@ -207,6 +207,9 @@ double surface_voxel(const Garment& g, const SurfaceOptions& options);
 /// garment_layers and SurfaceOptions::layers; empty when layers are off).
 std::vector<std::uint32_t> surface_layers(const Garment& g, const SurfaceOptions& options, double voxel);
 
+/// Whether a point is within epsilon of body B or inside it (called from several threads).
+using NearBody = std::function<bool(const Vec3&)>;
+
 /// Everything that depends only on the original garment and the feature samples.
 class SurfaceBinding {
  public:
@@ -246,10 +249,12 @@ class SurfaceBinding {
   /// empty without a zone). Adds to out.kept (per row) and the stats.
   Points emit_vertices(const AgentSolution& solution, const Points& original, const Points& warped,
                        const VertexBlends& blends, std::span<const std::uint8_t> carries_feature,
-                       const std::function<double(const Vec3&)>& distance_to_body_b, std::vector<std::uint8_t>& kept,
-                       SurfaceStats& stats) const;
+                       const NearBody& near_body_b, std::vector<std::uint8_t>& kept, SurfaceStats& stats) const;
   /// The signed distance to body B that apply(..., body_b, ...) uses (bounded a little beyond epsilon).
   std::function<double(const Vec3&)> body_distance(const BodySurface& body_b) const;
+  /// Whether a point is within epsilon of body B or inside it: body_distance's
+  /// value under epsilon, from a query of radius epsilon (eq. 14 for vertices).
+  NearBody near_body(const BodySurface& body_b) const;
   /// Whether the snap to the features runs (snap_to_features, feature_snap.hpp).
   bool snaps() const;
   const std::vector<std::int32_t>& feature_of() const { return feature_of_; }
@@ -330,8 +335,10 @@ class SurfaceBinding {
   std::vector<Eigen::Matrix3d> rotations(const Points& before, const Points& x, const std::vector<Eigen::Matrix3d>& stretch) const;
   std::vector<std::uint8_t> keep_near_vertices(const AgentSolution& solution, const Points& warped,
                                                const VertexBlends& blends, std::span<const std::uint8_t> carries_feature,
-                                               const std::function<double(const Vec3&)>& distance,
-                                               Points& positions) const;
+                                               const NearBody& near_body_b, Points& positions) const;
+  SurfaceResult apply(const Points& warped_vertices, const Points& feature_targets,
+                      const std::function<double(const Vec3&)>& distance_to_body_b, const NearBody& near_body_b,
+                      const Points* feature_warped, SurfaceSystem* system) const;
 
   SurfaceOptions options_;
   double h_ = 0.0;
