@@ -23,7 +23,8 @@ using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<do
 // nanoflann result set for eq. 2: nanoflann's KNNResultSet (same insertion, so
 // the same order among equal distances), but the search radius is also cut to
 // scale2 times the nearest distance found so far, and to an optional bound known
-// up front. Everything cut lies outside the final set.
+// up front. Everything cut lies outside the final set. With scale2 = +inf, the
+// k nearest (below the bound).
 class ScaledNearestSet {
  public:
   ScaledNearestSet(Index* idx, double* d2, std::size_t capacity, double scale2, double bound2)
@@ -46,7 +47,7 @@ class ScaledNearestSet {
   }
   double worstDist() const {
     double w = bound2_;
-    if (count_ > 0) w = std::min(w, scale2_ * d2_[0]);
+    if (count_ > 0 && std::isfinite(scale2_)) w = std::min(w, scale2_ * d2_[0]);  // scale2 +inf: a plain k-nearest set
     if (count_ == capacity_) w = std::min(w, d2_[capacity_ - 1]);
     return w;
   }
@@ -91,13 +92,26 @@ std::pair<Index, double> PointTree::nearest(const Vec3& p) const {
   return {impl_->cloud.id[idx], d2};
 }
 
-void PointTree::knn(const Vec3& p, std::size_t k, std::vector<Index>& idx, std::vector<double>& dist2) const {
+void PointTree::knn(const Vec3& p, std::size_t k, std::vector<Index>& idx, std::vector<double>& dist2,
+                    std::span<const Vec3> hint) const {
   k = std::min(k, size());
   idx.resize(k);
   dist2.resize(k);
   if (k == 0) return;
-  nanoflann::KNNResultSet<double, Index> rs(k);
-  rs.init(idx.data(), dist2.data());
+  // nanoflann's k-nearest set, but with its worst distance capped until it is
+  // full: k tree points as close as the hint's k-th bound the k-th nearest, so
+  // only farther points (never in the answer) are pruned, and ties among the
+  // answer's points go in the same order (ScaledNearestSet's argument).
+  double bound2 = std::numeric_limits<double>::infinity();
+  if (hint.size() >= k) {
+    std::vector<double>& h = dist2;
+    h.resize(hint.size());
+    for (std::size_t j = 0; j < hint.size(); ++j) h[j] = (p - hint[j]).squaredNorm();
+    std::nth_element(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(k - 1), h.end());
+    bound2 = h[k - 1] * (1.0 + 1e-9) + 1e-300;  // slack: a point nanoflann rounds differently stays in
+    dist2.resize(k);
+  }
+  ScaledNearestSet rs(idx.data(), dist2.data(), k, std::numeric_limits<double>::infinity(), bound2);
   impl_->tree->findNeighbors(rs, p.data(), nanoflann::SearchParams());
   idx.resize(rs.size());
   dist2.resize(rs.size());

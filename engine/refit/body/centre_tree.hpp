@@ -20,8 +20,12 @@ class PointTree {
   std::size_t size() const;
   /// Index of the nearest point and its squared distance.
   std::pair<Index, double> nearest(const Vec3& p) const;
-  /// The k nearest, closest first (fewer if the tree is smaller).
-  void knn(const Vec3& p, std::size_t k, std::vector<Index>& idx, std::vector<double>& dist2) const;
+  /// The k nearest, closest first (fewer if the tree is smaller). `hint`: k or
+  /// more distinct points of the tree thought to be near p (e.g. the previous
+  /// query's answer); the k-th nearest of them bounds the search from the start.
+  /// The hint only prunes: the answer is the same with or without it.
+  void knn(const Vec3& p, std::size_t k, std::vector<Index>& idx, std::vector<double>& dist2,
+           std::span<const Vec3> hint = {}) const;
   /// All points with squared distance < r2, closest first.
   void within(const Vec3& p, double r2, std::vector<std::pair<Index, double>>& out) const;
   /// The eq. 2 set of the warp (paper section 3), capped: of the k nearest points,

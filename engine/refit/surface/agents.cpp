@@ -383,12 +383,12 @@ LayerTrees::LayerTrees(const Points& points, const std::vector<std::uint32_t>& l
 LayerTrees::~LayerTrees() = default;
 
 void LayerTrees::knn(std::uint32_t layer, const Vec3& p, std::size_t k, std::vector<Index>& idx,
-                     std::vector<double>& dist2) const {
+                     std::vector<double>& dist2, std::span<const Vec3> hint) const {
   if (layer == 0 || layer >= impl_->tree.size() || impl_->index[layer].empty()) {
-    impl_->all.knn(p, k, idx, dist2);
+    impl_->all.knn(p, k, idx, dist2, hint);
     return;
   }
-  impl_->tree[layer]->knn(p, k, idx, dist2);
+  impl_->tree[layer]->knn(p, k, idx, dist2, hint);
   for (Index& i : idx) i = impl_->index[layer][i];
 }
 

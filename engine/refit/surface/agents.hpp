@@ -117,7 +117,9 @@ class LayerTrees {
   LayerTrees(const Points& points, const std::vector<std::uint32_t>& layer);
   ~LayerTrees();
   /// The k nearest points of layer `layer` (0: of all), closest first, as indices into the points.
-  void knn(std::uint32_t layer, const Vec3& p, std::size_t k, std::vector<Index>& idx, std::vector<double>& dist2) const;
+  /// `hint`: as PointTree::knn's, points of that layer (e.g. the previous query's answer).
+  void knn(std::uint32_t layer, const Vec3& p, std::size_t k, std::vector<Index>& idx, std::vector<double>& dist2,
+           std::span<const Vec3> hint = {}) const;
 
  private:
   struct Impl;

@@ -37,9 +37,16 @@ VertexBlends SurfaceBinding::vertex_blends(const Points& positions, std::span<co
     parallel_for(0, nv, 2048, [&](std::size_t b, std::size_t e) {
       std::vector<Index> idx;
       std::vector<double> d2;
+      // The previous vertex's agents (consecutive vertices are mostly near each
+      // other) bound the search from the start: same answers, less search.
+      std::vector<Vec3> hint;
       for (std::size_t v = b; v < e; ++v) {
         const Vec3 p = row3(positions, Index(v));
-        tree.knn(vertex_layer.empty() ? 0u : vertex_layer[v], p, kmax + 1, idx, d2);
+        const std::uint32_t layer = vertex_layer.empty() ? 0u : vertex_layer[v];
+        if (v > b && layer != (vertex_layer.empty() ? 0u : vertex_layer[v - 1])) hint.clear();
+        tree.knn(layer, p, kmax + 1, idx, d2, hint);
+        hint.clear();
+        for (Index i : idx) hint.push_back(row3(original_agents_, i));
         std::size_t m = 0;
         while (m < idx.size() && m < kmax && d2[m] < reach2) ++m;
         capped[v] = m == kmax && idx.size() > m && d2[m] < reach2;
