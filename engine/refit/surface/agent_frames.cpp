@@ -1,4 +1,5 @@
 #include <refit/core/parallel.hpp>
+#include <refit/core/union_find.hpp>
 #include <refit/surface/agent_frames.hpp>
 
 #include <Eigen/Eigenvalues>
@@ -18,11 +19,6 @@ constexpr std::size_t kGrain = 1024;
 Vec3 any_perpendicular(const Vec3& n) {
   const Vec3 t = std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
   return (t - t.dot(n) * n).normalized();
-}
-
-Index find_root(std::vector<Index>& parent, Index a) {
-  while (parent[a] != a) a = parent[a] = parent[parent[a]];
-  return a;
 }
 }  // namespace
 
