@@ -3,6 +3,7 @@
 #include <nanoflann.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace refit {
@@ -58,6 +59,25 @@ class ScaledNearestSet {
   std::size_t capacity_, count_ = 0;
   double scale2_, bound2_;
 };
+
+// Where a hinted search may stop looking: k hints as close as the k-th of
+// them bound the k-th nearest, and the nearest hint times scale2 bounds the
+// scaled set (when scale2 is finite); +inf without enough hints. With a
+// relative slack, so a point nanoflann rounds differently from here stays in.
+// `scratch` is overwritten.
+double hint_bound2(const Vec3& p, std::size_t k, double scale2, std::span<const Vec3> hint, std::vector<double>& scratch) {
+  double bound2 = std::numeric_limits<double>::infinity();
+  if (hint.empty()) return bound2;
+  scratch.resize(hint.size());
+  for (std::size_t j = 0; j < hint.size(); ++j) scratch[j] = (p - hint[j]).squaredNorm();
+  if (std::isfinite(scale2)) bound2 = scale2 * *std::min_element(scratch.begin(), scratch.end());
+  if (hint.size() >= k) {
+    std::nth_element(scratch.begin(), scratch.begin() + static_cast<std::ptrdiff_t>(k - 1), scratch.end());
+    bound2 = std::min(bound2, scratch[k - 1]);
+  }
+  return bound2 * (1.0 + 1e-9) + 1e-300;
+}
+
 }  // namespace
 
 struct PointTree::Impl {
@@ -102,15 +122,8 @@ void PointTree::knn(const Vec3& p, std::size_t k, std::vector<Index>& idx, std::
   // full: k tree points as close as the hint's k-th bound the k-th nearest, so
   // only farther points (never in the answer) are pruned, and ties among the
   // answer's points go in the same order (ScaledNearestSet's argument).
-  double bound2 = std::numeric_limits<double>::infinity();
-  if (hint.size() >= k) {
-    std::vector<double>& h = dist2;
-    h.resize(hint.size());
-    for (std::size_t j = 0; j < hint.size(); ++j) h[j] = (p - hint[j]).squaredNorm();
-    std::nth_element(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(k - 1), h.end());
-    bound2 = h[k - 1] * (1.0 + 1e-9) + 1e-300;  // slack: a point nanoflann rounds differently stays in
-    dist2.resize(k);
-  }
+  const double bound2 = hint_bound2(p, k, std::numeric_limits<double>::infinity(), hint, dist2);
+  dist2.resize(k);
   ScaledNearestSet rs(idx.data(), dist2.data(), k, std::numeric_limits<double>::infinity(), bound2);
   impl_->tree->findNeighbors(rs, p.data(), nanoflann::SearchParams());
   idx.resize(rs.size());
@@ -124,22 +137,8 @@ void PointTree::nearest_within_scaled(const Vec3& p, std::size_t k, double scale
   idx.resize(k);
   dist2.resize(k);
   if (k == 0) return;
-  // Squared distances to the hints, kept in dist2 (overwritten by the search).
-  double bound2 = std::numeric_limits<double>::infinity();
-  if (!hint.empty()) {
-    std::vector<double>& h = dist2;
-    h.resize(std::max(k, hint.size()));
-    for (std::size_t j = 0; j < hint.size(); ++j) h[j] = (p - hint[j]).squaredNorm();
-    bound2 = scale2 * *std::min_element(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(hint.size()));
-    if (hint.size() >= k) {
-      std::nth_element(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(k - 1), h.begin() + static_cast<std::ptrdiff_t>(hint.size()));
-      bound2 = std::min(bound2, h[k - 1]);
-    }
-    // Relative slack: a point whose distance nanoflann rounds differently from
-    // this one stays inside the search.
-    bound2 = bound2 * (1.0 + 1e-9) + 1e-300;
-    dist2.resize(k);
-  }
+  const double bound2 = hint_bound2(p, k, scale2, hint, dist2);
+  dist2.resize(k);
   ScaledNearestSet rs(idx.data(), dist2.data(), k, scale2, bound2);
   impl_->tree->findNeighbors(rs, p.data(), nanoflann::SearchParams());
   std::size_t m = std::min<std::size_t>(1, rs.size());
