@@ -97,6 +97,19 @@ bool face_needs(const Garment& g, const Points& positions, std::size_t f, const 
       if ((*outside_by)[v] - (q - row3(positions, v)).norm() >= clearance + margin) return true;
     return false;
   };
+  // A corner whose clear ball holds every corner holds the whole face (its fan
+  // triangles lie in the corners' hull), centre and samples alike: the tests
+  // below would clear each of them. Most faces of a dense garment end here
+  // (the 1M dress: about 30 square roots a face saved).
+  if (outside_by)
+    for (Index v : face) {
+      const double reach = (*outside_by)[v] - clearance - margin;
+      if (!(reach > 0.0)) continue;
+      const Vec3 pv = row3(positions, v);
+      if (std::all_of(face.begin(), face.end(),
+                      [&](Index u) { return (row3(positions, u) - pv).squaredNorm() <= reach * reach; }))
+        return false;
+    }
   // The distance to the body changes no faster than the point moves: a sample
   // closer to an outside centre than the centre's distance less the clearance
   // clears the body too.
