@@ -264,6 +264,42 @@ TEST(Collision, TheBodyPokingThroughAFaceAwayFromItsCentreIsPushedOutToo) {
   EXPECT_EQ(measure_sanity(g, out).flipped_faces, 0u);
 }
 
+TEST(Collision, AFaceOnlyItsCornersClearIsStillAsked) {
+  // A small triangle 0.09 above the tip of a narrow pyramid, its corners 0.06
+  // from the axis: each corner clears the tip by 0.108 (over the clearance,
+  // 0.1), and every corner lies within 0.108 of every other (edge 0.104), but
+  // the centre is 0.09 off the tip. A corner's clear ball covers the face only
+  // once the clearance is taken off its radius, so the face is asked and pushed.
+  BodyMesh pyramid;
+  pyramid.vertices.resize(4, 3);
+  pyramid.vertices.row(0) << 0.0, 0.0, 0.0;
+  for (int k = 0; k < 3; ++k) {
+    const double a = 2.0 * M_PI * k / 3.0;
+    pyramid.vertices.row(k + 1) << 0.3 * std::cos(a), -1.0, 0.3 * std::sin(a);
+  }
+  pyramid.triangles = {{0, 2, 1}, {0, 3, 2}, {0, 1, 3}, {1, 2, 3}};
+  const BodySurface body(pyramid);
+  Garment g;
+  g.positions.resize(3, 3);
+  for (int k = 0; k < 3; ++k) {
+    const double a = 2.0 * M_PI * k / 3.0 + 0.3;
+    g.positions.row(k) << 0.06 * std::cos(a), 0.09, 0.06 * std::sin(a);
+  }
+  g.faces.push_row(std::array<Index, 3>{0, 1, 2});
+  CollisionOptions o;
+  o.clearance = 0.1;
+  o.face_clearance = 0.1;
+  Points out = g.positions;
+  for (Index v = 0; v < 3; ++v) ASSERT_NEAR(body.closest(row3(out, v)).distance, 0.108, 1e-3) << v;
+  const Vec3 centre_before = (row3(out, 0) + row3(out, 1) + row3(out, 2)) / 3.0;
+  ASSERT_NEAR(body.closest(centre_before).distance, 0.09, 1e-9);
+  const CollisionReport r = resolve_penetrations(g, out, body, o);
+  EXPECT_EQ(r.too_close, 0u);  // no vertex of its own
+  const Vec3 centre = (row3(out, 0) + row3(out, 1) + row3(out, 2)) / 3.0;
+  EXPECT_GE(body.closest(centre).distance, 0.099);
+  EXPECT_EQ(r.moved, 3u);
+}
+
 TEST(Collision, SphereShellPartlyInsideComesOutBitIdenticalForAnyThreadCount) {
   const BodySurface body(sphere_body(3, 10.0));
   const Garment g = sphere_garment(3, 10.4);
