@@ -304,3 +304,27 @@ def mirror_partners(positions, centre_x=0.0, tol=0.3):
     d, j = tree.query(mirrored)
     j[d > tol] = -1
     return j
+
+
+def dihedral_change(original, result, faces):
+    """Per edge that exactly two faces share (vertex indices), the change of the angle
+    between their normals from `original` to `result`, in degrees: a fold line or a
+    groove the result adds (a pinch) shows as a large change along a few edges,
+    while a smooth bend of a fine mesh spreads small ones."""
+    edges = {}
+    for fi, f in enumerate(faces):
+        for k in range(len(f)):
+            a, b = f[k], f[(k + 1) % len(f)]
+            if a != b:
+                edges.setdefault((min(a, b), max(a, b)), []).append(fi)
+    pairs = np.asarray([v for v in edges.values() if len(v) == 2], dtype=np.int64).reshape(-1, 2)
+    if len(pairs) == 0:
+        return np.zeros(0)
+
+    def angles(x):
+        n = face_normals(x, faces)
+        n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
+        cos = np.clip(np.einsum("ij,ij->i", n[pairs[:, 0]], n[pairs[:, 1]]), -1.0, 1.0)
+        return np.degrees(np.arccos(cos))
+
+    return np.abs(angles(result) - angles(original))
