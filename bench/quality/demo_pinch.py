@@ -46,14 +46,8 @@ def front_waist(features_path):
 
 def score(original, result, faces, centre):
     change = meshes.dihedral_change(original, result, faces)
-    edges = {}
-    for fi, f in enumerate(faces):
-        for k in range(len(f)):
-            a, b = f[k], f[(k + 1) % len(f)]
-            if a != b:
-                edges.setdefault((min(a, b), max(a, b)), []).append(fi)
-    pairs = [v for v in edges.values() if len(v) == 2]
-    mid = np.asarray([original[faces[p[0]]].mean(axis=0) for p in pairs])
+    # Each edge placed at its first face's centre on body A.
+    mid = np.asarray([original[faces[p[0]]].mean(axis=0) for p in meshes.face_pairs(faces)])
     near = np.linalg.norm(mid - centre, axis=1) <= RADIUS_CM
     return {
         "waist_edges_over": int((change[near] > THRESHOLD_DEG).sum()),

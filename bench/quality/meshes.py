@@ -306,18 +306,23 @@ def mirror_partners(positions, centre_x=0.0, tol=0.3):
     return j
 
 
-def dihedral_change(original, result, faces):
-    """Per edge that exactly two faces share (vertex indices), the change of the angle
-    between their normals from `original` to `result`, in degrees: a fold line or a
-    groove the result adds (a pinch) shows as a large change along a few edges,
-    while a smooth bend of a fine mesh spreads small ones."""
+def face_pairs(faces):
+    """The two faces of every edge that exactly two faces share (vertex indices), (m, 2)."""
     edges = {}
     for fi, f in enumerate(faces):
         for k in range(len(f)):
             a, b = f[k], f[(k + 1) % len(f)]
             if a != b:
                 edges.setdefault((min(a, b), max(a, b)), []).append(fi)
-    pairs = np.asarray([v for v in edges.values() if len(v) == 2], dtype=np.int64).reshape(-1, 2)
+    return np.asarray([v for v in edges.values() if len(v) == 2], dtype=np.int64).reshape(-1, 2)
+
+
+def dihedral_change(original, result, faces):
+    """Per edge of face_pairs(faces), the change of the angle between its two faces'
+    normals from `original` to `result`, in degrees: a fold line or a groove the
+    result adds (a pinch) shows as a large change along a few edges, while a smooth
+    bend of a fine mesh spreads small ones."""
+    pairs = face_pairs(faces)
     if len(pairs) == 0:
         return np.zeros(0)
 
