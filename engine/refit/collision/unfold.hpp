@@ -71,6 +71,15 @@ void unfold(const Garment& g, const Points& positions, const std::vector<Index>&
   std::vector<std::uint8_t> turned(faces.size(), 0), dirty(faces.size(), 0);
   std::vector<std::size_t> test(faces.size());  // the faces to test this pass, ascending
   for (std::size_t i = 0; i < faces.size(); ++i) test[i] = i;
+  // The turned faces, ascending: a face keeps its verdict until it is tested
+  // again, so each pass merges the tested faces' new verdicts into the list
+  // instead of reading every face (the 1M dress's first round: 625k faces, 10 passes).
+  std::vector<std::size_t> turned_list, merged;
+  // Per region slot, the sum and count of its turned faces' mean displacements;
+  // zeroed again after each pass where they were used.
+  std::vector<Vec3> sum(region.size(), Vec3::Zero());
+  std::vector<int> count(region.size(), 0);
+  std::vector<std::size_t> used;  // slots with count > 0 this pass
   for (int pass = 0; pass < passes; ++pass) {
     parallel_for(0, test.size(), 256, [&](std::size_t b, std::size_t e) {
       for (std::size_t t = b; t < e; ++t) {
@@ -78,12 +87,20 @@ void unfold(const Garment& g, const Points& positions, const std::vector<Index>&
         turned[i] = before[i].squaredNorm() > 0.0 && displaced_face_normal(g, positions, faces[i], slot_of, &disp).dot(before[i]) <= 0.0;
       }
     });
-    std::vector<Vec3> sum(region.size(), Vec3::Zero());
-    std::vector<int> count(region.size(), 0);
-    bool any = false;
-    for (std::size_t i = 0; i < faces.size(); ++i) {
-      if (!turned[i]) continue;
-      any = true;
+    merged.clear();
+    for (std::size_t a = 0, t = 0; a < turned_list.size() || t < test.size();) {
+      if (t == test.size() || (a < turned_list.size() && turned_list[a] < test[t])) {
+        merged.push_back(turned_list[a++]);  // not tested again: still turned
+      } else {
+        if (a < turned_list.size() && turned_list[a] == test[t]) ++a;
+        if (turned[test[t]]) merged.push_back(test[t]);
+        ++t;
+      }
+    }
+    std::swap(turned_list, merged);
+    if (turned_list.empty()) return;
+    used.clear();
+    for (std::size_t i : turned_list) {  // in face order: the sums are the same for any thread count
       const auto face = g.faces.row(faces[i]);
       Vec3 mean = Vec3::Zero();
       for (Index v : face) {
@@ -94,15 +111,15 @@ void unfold(const Garment& g, const Points& positions, const std::vector<Index>&
       for (Index v : face) {
         const long k = slot_of(v);
         if (k < 0) continue;
+        if (count[std::size_t(k)]++ == 0) used.push_back(std::size_t(k));
         sum[std::size_t(k)] += mean;
-        ++count[std::size_t(k)];
       }
     }
-    if (!any) return;
     test.clear();
-    for (std::size_t k = 0; k < region.size(); ++k) {
-      if (count[k] == 0) continue;
+    for (std::size_t k : used) {
       const Vec3 d = sum[k] / double(count[k]);
+      sum[k] = Vec3::Zero();
+      count[k] = 0;
       if (d == disp[k]) continue;
       disp[k] = d;
       for (std::size_t a = start[k]; a < start[k + 1]; ++a)
