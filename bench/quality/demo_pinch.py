@@ -15,6 +15,9 @@ bend of this fine mesh changes each edge by little. Printed per method: the edge
 over 12 degrees within 4 cm of the front profile's top end (the waist at the centre
 front), the largest change there, and the same over the whole dress.
 
+With --assert the exit status is 1 when Refit leaves any edge there over the threshold
+(issue 13: "refit demo shows no pinch at the centre-front waist"; CTest runs it).
+
 With --refit-args the demo's dress is resized again with those options (same files),
 to compare switches, e.g. --refit-args="--feature-zone 0".
 """
@@ -63,6 +66,8 @@ def main():
     ap.add_argument("--refit", default="build/release/tools/refit")
     ap.add_argument("--out-dir", default=None, help="where the demo writes (default: a temporary folder)")
     ap.add_argument("--refit-args", default="", help="resize the demo's dress again with these options")
+    ap.add_argument("--assert", dest="check", action="store_true",
+                    help="exit 1 when Refit bends an edge near the centre-front waist by more than the threshold")
     args = ap.parse_args()
     out = args.out_dir or tempfile.mkdtemp(prefix="refit-demo-pinch-")
     subprocess.run([args.refit, "demo", "--out-dir", out, "--quiet"], check=True, stdout=subprocess.DEVNULL)
@@ -82,6 +87,13 @@ def main():
         s = score(original, meshes.read_positions(path), faces, centre)
         print("| %s | %d (of %d) | %.1f | %d | %.1f |" % (name, s["waist_edges_over"], s["waist_edges"],
                                                          s["waist_max_deg"], s["all_edges_over"], s["all_max_deg"]))
+    if args.check:
+        if s["waist_edges"] == 0:
+            sys.exit("demo_pinch: no edge of the demo dress lies near the centre-front waist")
+        if s["waist_edges_over"] > 0:
+            sys.exit("demo_pinch: Refit bends %d edges within %.0f cm of the centre-front waist by more than %.0f "
+                     "degrees (largest %.1f): a pinch" % (s["waist_edges_over"], RADIUS_CM, THRESHOLD_DEG,
+                                                          s["waist_max_deg"]))
 
 
 if __name__ == "__main__":

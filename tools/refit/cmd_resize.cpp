@@ -223,6 +223,7 @@ int run(ResizeArgs a) {
     options.surface.smooth_passes = 0;
     options.surface.keep_clear_of_body = false;
     options.surface.feature_zone_rings = 0;  // no zone, no snap
+    options.surface.feature_bend_radius = 0.0;
     options.surface.layers = false;
     options.surface.follow_body_scale = false;
   }
@@ -395,6 +396,12 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
       ->capture_default_str()
       ->check(CLI::Range(0, 16))
       ->group(kAdvanced);
+  app.add_option("--feature-bend", a->surface.feature_bend_radius,
+                 "Within about this distance of a feature (cm) the surface is solved again so that it leaves the "
+                 "feature with the feature's slope instead of a crease (0 = off: the paper's eq. 13 alone; docs/method.md)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100.0))
+      ->group(kAdvanced);
   app.add_flag("--no-layers", [a](std::int64_t) { a->surface.layers = false; },
                "One agent per voxel for the whole garment, as the paper (by default each layer of a multi-layer "
                "garment gets its own agents, rings and blends)")
@@ -421,7 +428,7 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
       ->group(kAdvanced);
   app.add_flag("--paper-surface", a->paper_surface,
                "Surface step as the paper: fan-normal frames, eq. 4 blend of the warped vertices, no smoothing, no layers, "
-               "absolute size, --feature-zone 0")
+               "absolute size, --feature-zone 0, --feature-bend 0")
       ->group(kAdvanced);
   app.add_option("--symmetry", a->symmetry,
                  "auto: mirror each one-sided feature about x = c when garment and body A are mirror-symmetric; "

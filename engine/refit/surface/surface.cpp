@@ -7,6 +7,7 @@
 #include <refit/core/progress.hpp>
 #include <refit/surface/agents.hpp>
 #include <refit/surface/clearance.hpp>
+#include <refit/surface/feature_bend.hpp>
 #include <refit/surface/feature_snap.hpp>
 #include <refit/surface/surface.hpp>
 
@@ -328,6 +329,18 @@ SurfaceBinding::AgentSolution SurfaceBinding::solve_agents(Points before_in, con
     system->start = x_start;
     for (std::size_t a = 0; a < n; ++a)
       if (fixed[a] == 3) system->start.row(Eigen::Index(a)) = x.row(Eigen::Index(a));  // held where the rounds put it
+  }
+  if (options_.feature_bend_radius > 0.0 && nf > 0 && h_ > 0.0) {
+    st.feature_bend_rings = int(std::min(64.0, std::round(options_.feature_bend_radius / h_)));
+    std::function<std::size_t(const std::vector<std::uint8_t>&)> hold;
+    if (clear)
+      hold = [&](const std::vector<std::uint8_t>& solved) {
+        return hold_clear_of_body(distance, options_.clearance, step, solved, before, x, fixed);
+      };
+    const FeatureBendReport bend = bend_around_features(rows, h_fine, st.feature_bend_rings, fr, fixed, x,
+                                                        options_.clearance_rounds, hold);
+    st.feature_bend_agents = bend.agents;
+    st.feature_bend_rounds = bend.rounds;
   }
   std::vector<std::uint8_t> anchored_kept(n, 0);
   if (st.anchored > 0) st.anchored_followed = follow_anchored(before, fixed, fr, x, anchored_kept);

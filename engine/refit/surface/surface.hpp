@@ -52,6 +52,10 @@ struct SurfaceOptions {
                                    // feature agents), under which a feature running within epsilon of the body (the side
                                    // seams of a tight dress) mostly stays as warped. The clearance rounds and the
                                    // collision step still keep the zone off the body. At most 16
+  double feature_bend_radius = 16.0;  // beyond the paper: within about this distance of a feature (one-ring steps of
+                                   // the voxel size h; garment units, the pipeline passes cm) the surface is solved again
+                                   // in least squares over eq. 13's rows and the feature agents' own, so it leaves a
+                                   // held curve with the curve's slope instead of a crease (feature_bend.hpp); 0: off
   bool snap_to_features = true;    // with a feature zone: correct the vertices near the features so that the written
                                    // garment passes through the optimised curves (see feature_snap.hpp)
   double snap_regularisation = 1e-3;  // Tikhonov weight of that correction, relative to its normal equations' diagonal
@@ -119,6 +123,9 @@ struct SurfaceStats {
   std::size_t fixed_body = 0, fixed_feature = 0;
   std::size_t fixed_clearance = 0;  // agents the solve left closer than the clearance to body B, then held at it
   int clearance_rounds = 0;         // re-solves after adding such agents
+  std::size_t feature_bend_agents = 0;  // agents solved again around the features (feature_bend.hpp)
+  int feature_bend_rings = 0;           // ... within this many one-ring steps of a feature agent
+  int feature_bend_rounds = 0;          // ... in this many least-squares solves (one more per clearance round)
   std::size_t anchored = 0, anchored_groups = 0;  // agents (and their groups) with no fixed agent
   std::size_t anchored_followed = 0;  // of those, moved with solved agents within reach (the rest stay as warped)
   int iterations = 0;
