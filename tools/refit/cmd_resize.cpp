@@ -224,6 +224,7 @@ int run(ResizeArgs a) {
     options.surface.keep_clear_of_body = false;
     options.surface.feature_zone_rings = 0;  // no zone, no snap
     options.surface.feature_bend_radius = 0.0;
+    options.surface.near_body_band = 0.0;
     options.surface.layers = false;
     options.surface.follow_body_scale = false;
   }
@@ -390,6 +391,13 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
   app.add_option("--epsilon", a->surface.epsilon, "Agents closer than this to body B (cm) keep their warped position")
       ->capture_default_str()
       ->group(kAdvanced);
+  app.add_option("--near-body-band", a->surface.near_body_band,
+                 "On a piece with features that mostly hangs off the body, agents within --epsilon of body B are "
+                 "solved with the rest and held only where they would stand more than this (cm) farther off body B "
+                 "than the warp puts them (0 = the paper's eq. 14 everywhere: held at the warp)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber)
+      ->group(kAdvanced);
   app.add_option("--feature-zone", a->surface.feature_zone_rings,
                  "Within this many one-ring steps of a feature, the feature wins over --epsilon and the garment is "
                  "snapped through it (0 = the paper: --epsilon everywhere but on the features)")
@@ -428,7 +436,7 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
       ->group(kAdvanced);
   app.add_flag("--paper-surface", a->paper_surface,
                "Surface step as the paper: fan-normal frames, eq. 4 blend of the warped vertices, no smoothing, no layers, "
-               "absolute size, --feature-zone 0, --feature-bend 0")
+               "absolute size, --feature-zone 0, --feature-bend 0, --near-body-band 0")
       ->group(kAdvanced);
   app.add_option("--symmetry", a->symmetry,
                  "auto: mirror each one-sided feature about x = c when garment and body A are mirror-symmetric; "

@@ -58,6 +58,7 @@ SurfaceOptions surface_options_in_units(const ResizeOptions& options) {
   so.epsilon *= per_cm;
   so.voxel *= per_cm;
   so.feature_bend_radius *= per_cm;
+  so.near_body_band *= per_cm;
   so.clearance = 2.0 * options.clearance_cm * per_cm;
   return so;
 }

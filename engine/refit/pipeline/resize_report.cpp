@@ -35,6 +35,8 @@ nlohmann::json surface_report(const SurfaceStats& s) {
           {"fixed_body", s.fixed_body},
           {"fixed_feature", s.fixed_feature},
           {"fixed_clearance", s.fixed_clearance},
+          {"banded", s.banded},
+          {"fixed_band", s.fixed_band},
           {"feature_bend_agents", s.feature_bend_agents},
           {"feature_bend_rings", s.feature_bend_rings},
           {"feature_bend_rounds", s.feature_bend_rounds},

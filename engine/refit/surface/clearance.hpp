@@ -35,4 +35,13 @@ std::size_t hold_clear_of_body(const std::function<double(const Vec3&)>& distanc
                                const std::vector<std::uint8_t>& free, const Points& warped, Points& x,
                                std::vector<std::uint8_t>& fixed);
 
+/// Beyond the paper's eq. 14 (SurfaceOptions::near_body_band): moves every agent
+/// with free[a] whose x lies farther from body B than ceiling[a] to the nearest
+/// point at that distance (Newton steps as clear_point; where they fail, the point
+/// on the way back to `warped` that is that close), marks it fixed[a] = 4 and
+/// returns how many it moved. Parallel; the result does not depend on the threads.
+std::size_t hold_near_body(const std::function<double(const Vec3&)>& distance, const std::vector<double>& ceiling,
+                           double step, const std::vector<std::uint8_t>& free, const Points& warped, Points& x,
+                           std::vector<std::uint8_t>& fixed);
+
 }  // namespace refit

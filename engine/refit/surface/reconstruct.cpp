@@ -218,6 +218,7 @@ std::vector<std::uint8_t> SurfaceBinding::keep_near_vertices(const AgentSolution
     for (std::size_t v = b; v < e; ++v) {
       const Index a = blends.nearest[v];
       if (!near_feature_.empty() && (near_feature_[a] || carries_feature[v])) continue;
+      if (!sol.banded.empty() && sol.banded[a]) continue;
       const Vec3 p = row3(warped, Index(v));
       if (feature_of_[a] < 0 && body_distance[a] - (p - row3(before, a)).norm() >= options_.epsilon) continue;
       if (near_body_b(p)) {

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 namespace refit {
@@ -225,8 +226,10 @@ SurfaceBinding::AgentSolution SurfaceBinding::solve_agents(Points before_in, con
 
   // Constraints: eq. 15 for feature agents, eq. 14 within epsilon of body B
   // (or inside it: the distance is signed) except in the features' zone (see
-  // SurfaceOptions::feature_zone_rings). fixed: 2 feature, 1 body, 3 clearance.
-  std::vector<std::uint8_t> fixed(n, 0);
+  // SurfaceOptions::feature_zone_rings). fixed: 2 feature, 1 body, 3 clearance,
+  // 4 band: with near_body_band, eq. 14's agents on a hanging piece with features
+  // get a ceiling instead (hold_near_body), applied with the clearance rounds.
+  std::vector<std::uint8_t> fixed(n, 0), near(n, 0);
   std::vector<double> body_distance(n, 0.0);
   parallel_for(0, n, 256, [&](std::size_t b, std::size_t e) {
     for (std::size_t a = b; a < e; ++a) {
@@ -234,10 +237,38 @@ SurfaceBinding::AgentSolution SurfaceBinding::solve_agents(Points before_in, con
         fixed[a] = 2;
       } else {
         body_distance[a] = distance(row3(before, Index(a)));
-        if (body_distance[a] < options_.epsilon && (near_feature_.empty() || !near_feature_[a])) fixed[a] = 1;
+        near[a] = body_distance[a] < options_.epsilon && (near_feature_.empty() || !near_feature_[a]);
       }
     }
   });
+  std::vector<std::uint8_t> banded;
+  std::vector<double> ceiling;
+  if (options_.near_body_band > 0.0 && options_.keep_clear_of_body && options_.clearance_rounds > 0) {
+    // Per piece: its agents, those on the body (the features' own and their zone
+    // counted: how much of the piece lies on the body) and its feature agents.
+    std::vector<std::size_t> agents_of(n, 0), near_of(n, 0), features_of(n, 0);
+    for (std::size_t a = 0; a < n; ++a) {
+      const Index g = group_[a];
+      ++agents_of[g];
+      near_of[g] += feature_of_[a] < 0 && body_distance[a] < options_.epsilon;
+      features_of[g] += feature_of_[a] >= 0;
+    }
+    banded.assign(n, 0);
+    ceiling.assign(n, std::numeric_limits<double>::infinity());
+    for (std::size_t a = 0; a < n; ++a) {
+      const Index g = group_[a];
+      // A piece without features has nothing to keep its shape towards (and no fixed agent without eq. 14).
+      if (!near[a] || features_of[g] == 0 || double(near_of[g]) > options_.near_body_band_share * double(agents_of[g]))
+        continue;
+      banded[a] = 1;
+      ++st.banded;
+      near[a] = 0;
+      ceiling[a] = std::max(body_distance[a], options_.clearance) + options_.near_body_band;
+    }
+  }
+  for (std::size_t a = 0; a < n; ++a)
+    if (near[a]) fixed[a] = 1;
+  const bool band = !banded.empty();
   for (std::size_t a = 0; a < n; ++a) {
     st.fixed_feature += fixed[a] == 2;
     st.fixed_body += fixed[a] == 1;
@@ -301,7 +332,14 @@ SurfaceBinding::AgentSolution SurfaceBinding::solve_agents(Points before_in, con
   // Clearance rounds (clearance.hpp): free agents the solve sinks into body B
   // are held clear of it and the system is solved again.
   const double step = 1e-3 * h_;
-  auto hold_clear = [&] { return hold_clear_of_body(distance, options_.clearance, step, fr, before, x, fixed); };
+  auto hold_band = [&](const std::vector<std::uint8_t>& solved) {
+    const std::size_t held = band ? hold_near_body(distance, ceiling, step, solved, before, x, fixed) : 0;
+    st.fixed_band += held;
+    return held;
+  };
+  auto hold_clear = [&] {
+    return hold_clear_of_body(distance, options_.clearance, step, fr, before, x, fixed) + hold_band(fr);
+  };
   // The first solve only finds which agents sink: it stops at 100 times the
   // tolerance (measured on the 1M dress: 172 fine sweeps in all -> 112). The
   // solves after it go to the tolerance, and agents they sink start another round.
@@ -328,14 +366,14 @@ SurfaceBinding::AgentSolution SurfaceBinding::solve_agents(Points before_in, con
     system->free = fr;
     system->start = x_start;
     for (std::size_t a = 0; a < n; ++a)
-      if (fixed[a] == 3) system->start.row(Eigen::Index(a)) = x.row(Eigen::Index(a));  // held where the rounds put it
+      if (fixed[a] >= 3) system->start.row(Eigen::Index(a)) = x.row(Eigen::Index(a));  // held where the rounds put it
   }
   if (options_.feature_bend_radius > 0.0 && nf > 0 && h_ > 0.0) {
     st.feature_bend_rings = int(std::min(64.0, std::round(options_.feature_bend_radius / h_)));
     std::function<std::size_t(const std::vector<std::uint8_t>&)> hold;
     if (clear)
       hold = [&](const std::vector<std::uint8_t>& solved) {
-        return hold_clear_of_body(distance, options_.clearance, step, solved, before, x, fixed);
+        return hold_clear_of_body(distance, options_.clearance, step, solved, before, x, fixed) + hold_band(solved);
       };
     const FeatureBendReport bend = bend_around_features(rows, h_fine, st.feature_bend_rings, fr, fixed, x,
                                                         options_.clearance_rounds, hold);
@@ -350,6 +388,7 @@ SurfaceBinding::AgentSolution SurfaceBinding::solve_agents(Points before_in, con
   if (options_.emit_from_original && !options_.encode_on_warped && st.anchored > st.anchored_followed)
     sol.keep = std::move(anchored_kept);
   sol.body_distance = std::move(body_distance);
+  sol.banded = std::move(banded);
   sol.x = std::move(x);
   return sol;
 }

@@ -35,6 +35,13 @@ struct SurfaceOptions {
   std::size_t agent_budget = 20000;  // target agent count for the auto voxel size
   std::size_t max_agents = 1000000;  // an explicit voxel size that needs more is refused (about 1 GB, minutes; issue 17)
   double epsilon = 1.0;            // an agent closer than this to body B keeps its warped position (eq. 14)
+  double near_body_band = 0.3;     // beyond the paper, on a piece with features that mostly hangs off the body
+                                   // (near_body_band_share): eq. 14's agents are solved with the rest, held only where
+                                   // the solve leaves them more than this farther off body B than the warp puts them
+                                   // (the clearance rounds keep them off it), and their vertices are not kept at the
+                                   // warp: the surface between the features keeps its shape (issue 13). 0: eq. 14
+  double near_body_band_share = 1.0 / 3.0;  // ... on pieces with at most this share of their agents within epsilon
+                                   // of body B (a skirt hanging from the hips; a fitted dress keeps eq. 14)
   int max_iterations = 500;        // Gauss-Seidel iterations, at most
   double tolerance = 1e-5;         // stop when an iteration's update has an L2 norm below this
   double relaxation = 1.0;         // over-relaxation factor of the sweeps (1 = the paper's Gauss-Seidel). Measured on the
@@ -121,6 +128,8 @@ struct SurfaceStats {
   std::size_t blocks = 0, sequential_agents = 0;
   double block_width = 0.0;
   std::size_t fixed_body = 0, fixed_feature = 0;
+  std::size_t banded = 0;           // agents eq. 14 would hold that near_body_band frees (on hanging pieces with features)
+  std::size_t fixed_band = 0;       // ... of which held at their warped distance to body B plus the band
   std::size_t fixed_clearance = 0;  // agents the solve left closer than the clearance to body B, then held at it
   int clearance_rounds = 0;         // re-solves after adding such agents
   std::size_t feature_bend_agents = 0;  // agents solved again around the features (feature_bend.hpp)
@@ -246,6 +255,7 @@ class SurfaceBinding {
     std::vector<Eigen::Matrix3d> rotation; // per agent: from the state vertices are re-emitted from to x
     std::vector<std::uint8_t> keep;        // agents whose vertices are handed back as warped (empty: none)
     std::vector<double> body_distance;     // per agent: its distance to body B (eq. 14)
+    std::vector<std::uint8_t> banded;      // per agent: near body B but solved within the band (empty: none)
     SurfaceStats stats;
   };
   AgentSolution solve_agents(Points before, const Points& feature_targets,
