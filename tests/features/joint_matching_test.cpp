@@ -2,6 +2,7 @@
 // crossing curves: meeting samples coincide, each curve keeps its shape, a
 // similarity of the body moves every curve by that similarity, curves end clear
 // of body B, a one-sided profile and its mirror meet the hem like the others.
+#include <refit/core/error.hpp>
 #include <refit/features/bspline.hpp>
 #include <refit/features/shape_matching.hpp>
 #include <refit/features/symmetry.hpp>
@@ -205,6 +206,48 @@ TEST(JointMatching, SamplesEndClearOfBodyB) {
   EXPECT_FALSE(r.curves[0].cleared.empty());
   // Still one point where they meet.
   EXPECT_LT((row3(r.curves[1].optimised, 18) - row3(r.curves[0].optimised, 20)).norm(), 1e-9);
+}
+
+TEST(JointMatching, ASampleWithExtraClearanceKeepsItAndTheCurveBendsSmoothlyToIt) {
+  // As above; curve A's lowest sample away from its ends keeps 0.5 more than the
+  // clearance (a face under it dips towards the body).
+  const std::vector<FeatureCurve> curves = crossed_pair();
+  const auto sink = [](const Vec3& p) -> Vec3 { return bend(p) - Vec3(0, 2.5 * std::exp(-p.x() * p.x() / 8.0), 0); };
+  const ClearanceToBody floor = [](const Vec3& p, double clearance) {
+    return ClearanceNeed{Vec3::UnitY(), clearance - p.y()};
+  };
+  ShapeMatchingOptions o;
+  o.clearance = 0.25;
+  std::vector<Points> ws, wa;
+  for (const FeatureCurve& c : curves) {
+    ws.push_back(map_rows(c.samples, sink));
+    wa.push_back(map_rows(c.aux, sink));
+  }
+  const ShapeModel model = prepare_shape_model(curves, o);
+  const FeatureResult plain = match_shapes(model, ws, wa, to_body, floor);
+  // The lowest of A's samples away from its ends: at the clearance without the extra.
+  const Eigen::Index m = plain.curves[0].optimised.rows();
+  Eigen::Index low = 0;
+  plain.curves[0].optimised.col(1).segment(5, m - 10).minCoeff(&low);
+  low += 5;
+  ASSERT_LT(plain.curves[0].optimised(low, 1), 0.25 + 0.05);  // the test means something
+  std::vector<double> extra(curves[0].size() + curves[1].size(), 0.0);
+  extra[std::size_t(low)] = 0.5;
+  const FeatureResult r = match_shapes(model, ws, wa, to_body, floor, extra);
+  EXPECT_GE(r.curves[0].optimised(low, 1), 0.75 - 1e-3);
+  for (const CurveResult& c : r.curves) EXPECT_GE(c.optimised.col(1).minCoeff(), 0.25 - 1e-3) << c.name;
+  // Its neighbours rise with it (the move spreads along the curve, faded), none sinks.
+  const double lift = r.curves[0].optimised(low, 1) - plain.curves[0].optimised(low, 1);
+  const double lift1 = r.curves[0].optimised(low - 1, 1) - plain.curves[0].optimised(low - 1, 1);
+  std::printf("[ info ] extra clearance 0.5 on sample %ld: lifted %.3f, its neighbour %.3f\n", long(low), lift, lift1);
+  EXPECT_GT(lift1, 0.0);
+  EXPECT_LT(lift1, lift);
+  EXPECT_GE((r.curves[0].optimised.col(1) - plain.curves[0].optimised.col(1)).minCoeff(), -1e-9);
+  // Still one point where they meet.
+  EXPECT_LT((row3(r.curves[1].optimised, 18) - row3(r.curves[0].optimised, 20)).norm(), 1e-9);
+  // A wrong count is refused.
+  extra.pop_back();
+  EXPECT_THROW(match_shapes(model, ws, wa, to_body, floor, extra), Error);
 }
 
 TEST(JointMatching, SamplesThatSatOnBodyAFollowBodyB) {

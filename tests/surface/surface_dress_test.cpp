@@ -332,7 +332,9 @@ TEST(SurfaceDress, ManifoldAndSoupAgree) {
     // and where the duplicated seams change the samples.
     EXPECT_LT(sum, (band > 0.0 ? 0.35 : 0.3) * moved) << "band " << band;
     EXPECT_LT(worst, 1.5) << "band " << band;
-    if (band > 0.0) EXPECT_GT(m.stats.banded, 0u);
+    if (band > 0.0) {
+      EXPECT_GT(m.stats.banded, 0u);
+    }
   }
 }
 

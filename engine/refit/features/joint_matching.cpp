@@ -265,7 +265,7 @@ std::vector<Vec3> spread_moves(const ShapeModel& model, const std::vector<std::v
 
 FeatureResult match_shapes_jointly(const ShapeModel& model, const std::vector<Points>& warped_samples,
                                    const std::vector<Points>& warped_aux, const DistanceToBody& distance_to_body_b,
-                                   const ClearanceToBody& clearance_to_body_b) {
+                                   const ClearanceToBody& clearance_to_body_b, std::span<const double> extra_clearance) {
   const std::size_t count = model.curves.size();
   if (warped_samples.size() != count || warped_aux.size() != count)
     throw Error("feature optimisation: warped points given for " + std::to_string(warped_samples.size()) +
@@ -279,6 +279,17 @@ FeatureResult match_shapes_jointly(const ShapeModel& model, const std::vector<Po
       throw Error("feature '" + c.name + "': a warped sample is not finite");
   }
   const bool clear = o.clearance > 0.0 && clearance_to_body_b;
+  // Per curve and sample: the clearance it keeps (the option's, plus its extra).
+  std::size_t total = 0;
+  for (const FeatureCurve& c : model.curves) total += c.size();
+  if (!extra_clearance.empty() && extra_clearance.size() != total)
+    throw Error("feature optimisation: " + std::to_string(extra_clearance.size()) + " extra clearances given, expected " +
+                std::to_string(total));
+  std::vector<std::size_t> first_sample(count + 1, 0);
+  for (std::size_t k = 0; k < count; ++k) first_sample[k + 1] = first_sample[k] + model.curves[k].size();
+  const auto clearance_of = [&](std::size_t k, std::size_t i) {
+    return o.clearance + (extra_clearance.empty() ? 0.0 : extra_clearance[first_sample[k] + i]);
+  };
   std::vector<CurveFrame> frame;
   frame.reserve(count);
   for (std::size_t k = 0; k < count; ++k) frame.push_back(curve_frame(model.curves[k], warped_samples[k], warped_aux[k]));
@@ -357,7 +368,7 @@ FeatureResult match_shapes_jointly(const ShapeModel& model, const std::vector<Po
       if (i == anchor) {
         Vec3 p = row3(warped_samples[k], Index(i));
         if (clear) {
-          const ClearanceNeed need = clearance_to_body_b(p, o.clearance);
+          const ClearanceNeed need = clearance_to_body_b(p, clearance_of(k, i));
           if (need.amount > 0.0) p += need.amount * need.direction;
         }
         slot_pos.push_back(p);
@@ -452,8 +463,8 @@ FeatureResult match_shapes_jointly(const ShapeModel& model, const std::vector<Po
     pulled_by = spread_moves(model, expr, sys, pull, o.clearance_rounds);
   }
   if (clear) {
-    const auto push = [&](std::size_t, std::size_t, const Vec3& p) {
-      const ClearanceNeed need = clearance_to_body_b(p, o.clearance);
+    const auto push = [&](std::size_t k, std::size_t i, const Vec3& p) {
+      const ClearanceNeed need = clearance_to_body_b(p, clearance_of(k, i));
       return need.amount > 1e-3 * o.clearance ? need : ClearanceNeed{};
     };
     moved_by = spread_moves(model, expr, sys, push, o.clearance_rounds);

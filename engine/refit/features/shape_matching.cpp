@@ -181,8 +181,10 @@ ShapeModel prepare_shape_model(std::vector<FeatureCurve> curves, const ShapeMatc
 
 FeatureResult match_shapes(const ShapeModel& model, const std::vector<Points>& warped_samples,
                            const std::vector<Points>& warped_aux, const DistanceToBody& distance_to_body_b,
-                           const ClearanceToBody& clearance_to_body_b) {
-  if (model.options.joint) return match_shapes_jointly(model, warped_samples, warped_aux, distance_to_body_b, clearance_to_body_b);
+                           const ClearanceToBody& clearance_to_body_b, std::span<const double> extra_clearance) {
+  if (model.options.joint)
+    return match_shapes_jointly(model, warped_samples, warped_aux, distance_to_body_b, clearance_to_body_b,
+                                extra_clearance);
   return match_shapes_in_order(model, warped_samples, warped_aux, distance_to_body_b);
 }
 
@@ -435,13 +437,14 @@ FeatureBinding bind_features(const ReferenceBody& a, std::vector<FeatureCurve> c
 }
 
 FeatureResult optimise_features(const FeatureBinding& binding, const TriangleFrames& b_frames,
-                                const DistanceToBody& distance_to_body_b, const ClearanceToBody& clearance_to_body_b) {
+                                const DistanceToBody& distance_to_body_b, const ClearanceToBody& clearance_to_body_b,
+                                std::span<const double> extra_clearance) {
   std::vector<Points> ws, wa;
   for (std::size_t k = 0; k < binding.model.curves.size(); ++k) {
     ws.push_back(binding.samples[k].apply(b_frames));
     wa.push_back(binding.aux[k].apply(b_frames));
   }
-  return match_shapes(binding.model, ws, wa, distance_to_body_b, clearance_to_body_b);
+  return match_shapes(binding.model, ws, wa, distance_to_body_b, clearance_to_body_b, extra_clearance);
 }
 
 }  // namespace refit

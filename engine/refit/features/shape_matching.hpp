@@ -39,6 +39,7 @@
 
 #include <functional>
 #include <string>
+#include <span>
 #include <vector>
 
 namespace refit {
@@ -168,11 +169,14 @@ using ClearanceToBody = std::function<ClearanceNeed(const Vec3&, double clearanc
 /// Optimises every curve of `model` (eqs. 5-9), jointly or in order as the
 /// model's options say, given the warped samples and warped auxiliary points of
 /// each curve (rows matching the model's). `clearance_to_body_b` (joint solve,
-/// with options.clearance > 0) keeps the samples clear of body B. Throws
-/// refit::Error when the counts do not match or a warped point is not finite.
+/// with options.clearance > 0) keeps the samples clear of body B, each by the
+/// clearance plus its `extra_clearance` (per sample of all curves in order;
+/// empty: none). Throws refit::Error when the counts do not match or a warped
+/// point is not finite.
 FeatureResult match_shapes(const ShapeModel& model, const std::vector<Points>& warped_samples,
                            const std::vector<Points>& warped_aux, const DistanceToBody& distance_to_body_b,
-                           const ClearanceToBody& clearance_to_body_b = {});
+                           const ClearanceToBody& clearance_to_body_b = {},
+                           std::span<const double> extra_clearance = {});
 
 /// The paper's rule: one curve after the other, in the model's order.
 FeatureResult match_shapes_in_order(const ShapeModel& model, const std::vector<Points>& warped_samples,
@@ -181,7 +185,8 @@ FeatureResult match_shapes_in_order(const ShapeModel& model, const std::vector<P
 /// All curves in one solve (joint_matching.cpp).
 FeatureResult match_shapes_jointly(const ShapeModel& model, const std::vector<Points>& warped_samples,
                                    const std::vector<Points>& warped_aux, const DistanceToBody& distance_to_body_b,
-                                   const ClearanceToBody& clearance_to_body_b);
+                                   const ClearanceToBody& clearance_to_body_b,
+                                   std::span<const double> extra_clearance = {});
 
 /// Puts every crossing sample of `result` back on the curve it meets, where
 /// the joint solve defines it (after a change of the optimised samples, such as
@@ -215,6 +220,7 @@ FeatureBinding bind_features(const ReferenceBody& a, std::vector<FeatureCurve> c
 /// Apply many: warps samples and auxiliary points with body B's frames and
 /// optimises every curve (match_shapes).
 FeatureResult optimise_features(const FeatureBinding& binding, const TriangleFrames& b_frames,
-                                const DistanceToBody& distance_to_body_b, const ClearanceToBody& clearance_to_body_b = {});
+                                const DistanceToBody& distance_to_body_b, const ClearanceToBody& clearance_to_body_b = {},
+                                std::span<const double> extra_clearance = {});
 
 }  // namespace refit

@@ -1,3 +1,4 @@
+#include <limits>
 #include <refit/body/body_surface.hpp>
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
@@ -64,6 +65,38 @@ SurfaceOptions surface_options_in_units(const ResizeOptions& options) {
 }
 
 GarmentBinding::~GarmentBinding() = default;
+
+// A curve sample on a face that the input already sinks towards body A, a
+// corner closer to it than the collision clearance (the skirt's waistband: a
+// corner 0.19 cm inside body A under the front profile's top): the collision
+// step pushes that corner out on body B too, and the written garment left the
+// curve there (0.27 cm). The sample keeps its clearance plus how far that
+// corner lies below it on body A (less the margin the curves already keep, at
+// most kDippingFaceCapCm), so the face clears body B where it follows the curve.
+std::vector<double> GarmentBinding::dipping_face_clearance(const Points& samples) const {
+  const std::size_t n = feature_attachment_.vertex.size();
+  std::vector<double> extra(n, 0.0);
+  const double per_cm = units_per_cm(options_.units);
+  const double clearance = options_.clearance_cm * per_cm, margin = kFeatureClearanceMarginCm * per_cm;
+  const double cap = kDippingFaceCapCm * per_cm;
+  const BodySurface surface_a(body_a_.mesh());
+  surface_a.prepare_inside_test();
+  const auto signed_distance = [&](const Vec3& p) {
+    const double d = surface_a.closest(p).distance;
+    return surface_a.inside(p) ? -d : d;
+  };
+  parallel_for(0, n, 64, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      double lowest = std::numeric_limits<double>::infinity();
+      for (const Index v : feature_attachment_.vertex[i])
+        lowest = std::min(lowest, signed_distance(row3(garment_->positions, v)));
+      if (!(lowest < clearance)) continue;
+      const double below = signed_distance(row3(samples, Index(i))) - lowest;
+      extra[i] = std::clamp(below - margin, 0.0, cap);
+    }
+  });
+  return extra;
+}
 
 GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh body_a, ResizeOptions options,
                                std::vector<FeatureSpec> features, const Progress& progress)
@@ -148,6 +181,8 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
       const Points anchors = all_sample_anchors(features_->model.curves);
       feature_attachment_ = locate().attach(anchors);
       feature_attachment_.offset += all - anchors;
+      // With --follow-body the curves follow body B where they sat on body A instead.
+      if (options_.collision && !(options_.follow_body_cm > 0.0)) dip_clearance_ = dipping_face_clearance(all);
     }
     try {
       surface_ = SurfaceBinding::bind(*garment_, all, so, all.rows() > 0 ? &feature_attachment_ : nullptr);
@@ -300,9 +335,23 @@ void GarmentBinding::feature_step(const TriangleFrames& frames_b, const BodySurf
   progress.stage("optimising " + std::to_string(features_->model.curves.size()) + " feature curves");
   if (features_->model.options.clearance > 0.0) surface_b.prepare_inside_test();
   FeatureResult& curves = result.features;
+  // The dip only where the warp leaves that face's corner too close to body B as well.
+  std::vector<double> extra = dip_clearance_;
+  const double clearance = options_.clearance_cm * units_per_cm(options_.units);
+  parallel_for(0, extra.size(), 64, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      if (extra[i] == 0.0) continue;
+      bool close = false;
+      for (const Index v : feature_attachment_.vertex[i]) {
+        const Vec3 p = row3(result.warped, v);
+        close = close || surface_b.inside(p) || surface_b.closest_within(p, clearance).distance < clearance;
+      }
+      if (!close) extra[i] = 0.0;
+    }
+  });
   curves = optimise_features(
       *features_, frames_b, [&](const Vec3& p) { return surface_b.closest(p).distance; },
-      [&](const Vec3& p, double clearance) { return clearance_need(surface_b, p, clearance); });
+      [&](const Vec3& p, double clearance) { return clearance_need(surface_b, p, clearance); }, extra);
   if (symmetric_b && !feature_mirror_.empty()) {
     symmetrise_curves(curves, feature_mirror_, mirror_x_);
     restore_meetings(features_->model, curves);

@@ -95,6 +95,9 @@ class GarmentBinding {
   bool body_b_symmetric(const BodyMesh& body_b, nlohmann::json& report) const;
   void feature_step(const TriangleFrames& frames_b, const BodySurface& surface_b, bool symmetric_b,
                     const Stopwatch& clock, ResizeResult& result, const Progress& progress) const;
+  /// Per feature sample (all curves in order, at `samples` on the original), the
+  /// clearance it keeps beyond the option's where a face under it dips towards body A.
+  std::vector<double> dipping_face_clearance(const Points& samples) const;
   Points surface_step(const BodySurface& surface_b, bool symmetric_b, ResizeResult& result,
                       const Progress& progress) const;  // returns the features where the surface step leaves them
   void collision_step(const BodySurface& surface_b, bool symmetric_b, ResizeResult& result,
@@ -118,6 +121,7 @@ class GarmentBinding {
   std::optional<FeatureBinding> features_;
   std::optional<SurfaceBinding> surface_;
   SurfaceAttachment feature_attachment_;  // where the feature samples (all curves, in order) sit on the garment
+  std::vector<double> dip_clearance_;     // per feature sample: dipping_face_clearance (empty: none)
   nlohmann::json bind_report_;
   double memory_estimate_mb_ = 0.0;
   // The collision step's vertex adjacency: made by the first resize that needs
@@ -138,6 +142,8 @@ inline constexpr const char* kVersion = "0.1.0";
 /// With the collision step on, the joint feature solve keeps the curves this much
 /// farther from body B than the collision clearance (ShapeMatchingOptions::clearance 0).
 inline constexpr double kFeatureClearanceMarginCm = 0.05;
+/// The most a feature sample stands farther off body B for a face under it that dips (dipping_face_clearance).
+inline constexpr double kDippingFaceCapCm = 1.0;
 /// The collision step's pushes of a symmetric pair are made alike when they differ by more than this.
 inline constexpr double kSymmetricPushToleranceCm = 0.02;
 
