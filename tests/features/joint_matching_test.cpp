@@ -11,6 +11,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <span>
 #include <cstdio>
 #include <functional>
 #include <numbers>
@@ -46,14 +47,19 @@ std::vector<FeatureCurve> crossed_pair(double b_x = 0.0) {
 }
 
 FeatureResult solve(const std::vector<FeatureCurve>& curves, const std::function<Vec3(const Vec3&)>& warp,
-                    const ShapeMatchingOptions& o = {}, const ClearanceToBody& clearance = {}) {
+                    const ShapeMatchingOptions& o = {}, const ClearanceToBody& clearance = {},
+                    std::span<const double> extra_clearance = {}) {
   std::vector<Points> ws, wa;
   for (const FeatureCurve& c : curves) {
     ws.push_back(map_rows(c.samples, warp));
     wa.push_back(map_rows(c.aux, warp));
   }
-  return match_shapes(prepare_shape_model(curves, o), ws, wa, to_body, clearance);
+  return match_shapes(prepare_shape_model(curves, o), ws, wa, to_body, clearance, extra_clearance);
 }
+
+// Body B: everything below y = 0 ("inside"); this warp lowers A's middle into it.
+Vec3 sink(const Vec3& p) { return bend(p) - Vec3(0, 2.5 * std::exp(-p.x() * p.x() / 8.0), 0); }
+ClearanceNeed floor_need(const Vec3& p, double clearance) { return ClearanceNeed{Vec3::UnitY(), clearance - p.y()}; }
 
 }  // namespace
 
@@ -189,16 +195,11 @@ TEST(JointMatching, ProfilesAndTheirMirrorMeetALevelHemAndFollowTheBodysScale) {
 }
 
 TEST(JointMatching, SamplesEndClearOfBodyB) {
-  // Body B: everything below y = 0 ("inside"). The warp lowers A's middle into it.
   const std::vector<FeatureCurve> curves = crossed_pair();
-  const auto sink = [](const Vec3& p) -> Vec3 { return bend(p) - Vec3(0, 2.5 * std::exp(-p.x() * p.x() / 8.0), 0); };
-  const ClearanceToBody floor = [](const Vec3& p, double clearance) {
-    return ClearanceNeed{Vec3::UnitY(), clearance - p.y()};
-  };
   ShapeMatchingOptions o;
   o.clearance = 0.25;
   const FeatureResult free_result = solve(curves, sink);
-  const FeatureResult r = solve(curves, sink, o, floor);
+  const FeatureResult r = solve(curves, sink, o, floor_need);
   EXPECT_LT(free_result.curves[0].optimised.col(1).minCoeff(), 0.0);  // the test means something
   for (const CurveResult& c : r.curves) {
     EXPECT_GE(c.optimised.col(1).minCoeff(), 0.25 - 1e-3) << c.name;
@@ -212,19 +213,9 @@ TEST(JointMatching, ASampleWithExtraClearanceKeepsItAndTheCurveBendsSmoothlyToIt
   // As above; curve A's lowest sample away from its ends keeps 0.5 more than the
   // clearance (a face under it dips towards the body).
   const std::vector<FeatureCurve> curves = crossed_pair();
-  const auto sink = [](const Vec3& p) -> Vec3 { return bend(p) - Vec3(0, 2.5 * std::exp(-p.x() * p.x() / 8.0), 0); };
-  const ClearanceToBody floor = [](const Vec3& p, double clearance) {
-    return ClearanceNeed{Vec3::UnitY(), clearance - p.y()};
-  };
   ShapeMatchingOptions o;
   o.clearance = 0.25;
-  std::vector<Points> ws, wa;
-  for (const FeatureCurve& c : curves) {
-    ws.push_back(map_rows(c.samples, sink));
-    wa.push_back(map_rows(c.aux, sink));
-  }
-  const ShapeModel model = prepare_shape_model(curves, o);
-  const FeatureResult plain = match_shapes(model, ws, wa, to_body, floor);
+  const FeatureResult plain = solve(curves, sink, o, floor_need);
   // The lowest of A's samples away from its ends: at the clearance without the extra.
   const Eigen::Index m = plain.curves[0].optimised.rows();
   Eigen::Index low = 0;
@@ -233,7 +224,7 @@ TEST(JointMatching, ASampleWithExtraClearanceKeepsItAndTheCurveBendsSmoothlyToIt
   ASSERT_LT(plain.curves[0].optimised(low, 1), 0.25 + 0.05);  // the test means something
   std::vector<double> extra(curves[0].size() + curves[1].size(), 0.0);
   extra[std::size_t(low)] = 0.5;
-  const FeatureResult r = match_shapes(model, ws, wa, to_body, floor, extra);
+  const FeatureResult r = solve(curves, sink, o, floor_need, extra);
   EXPECT_GE(r.curves[0].optimised(low, 1), 0.75 - 1e-3);
   for (const CurveResult& c : r.curves) EXPECT_GE(c.optimised.col(1).minCoeff(), 0.25 - 1e-3) << c.name;
   // Its neighbours rise with it (the move spreads along the curve, faded), none sinks.
@@ -247,7 +238,7 @@ TEST(JointMatching, ASampleWithExtraClearanceKeepsItAndTheCurveBendsSmoothlyToIt
   EXPECT_LT((row3(r.curves[1].optimised, 18) - row3(r.curves[0].optimised, 20)).norm(), 1e-9);
   // A wrong count is refused.
   extra.pop_back();
-  EXPECT_THROW(match_shapes(model, ws, wa, to_body, floor, extra), Error);
+  EXPECT_THROW(solve(curves, sink, o, floor_need, extra), Error);
 }
 
 TEST(JointMatching, SamplesThatSatOnBodyAFollowBodyB) {
