@@ -79,11 +79,15 @@ std::vector<double> GarmentBinding::dipping_face_clearance(const Points& samples
   const double per_cm = units_per_cm(options_.units);
   const double clearance = options_.clearance_cm * per_cm, margin = kFeatureClearanceMarginCm * per_cm;
   const double cap = kDippingFaceCapCm * per_cm;
+  // Signed by the closest triangle's normal: only points within about a
+  // centimetre of body A count here, where that sign is the side they are on
+  // (and the inside test's grid, 0.1-0.2 s to build, is not needed).
   const BodySurface surface_a(body_a_.mesh());
-  surface_a.prepare_inside_test();
+  const double reach = clearance + cap + margin;
   const auto signed_distance = [&](const Vec3& p) {
-    const double d = surface_a.closest(p).distance;
-    return surface_a.inside(p) ? -d : d;
+    const ClosestPoint cp = surface_a.closest_within(p, reach);
+    if (!(cp.distance < reach)) return reach;
+    return (p - cp.point).dot(cp.normal) < 0.0 ? -cp.distance : cp.distance;
   };
   parallel_for(0, n, 64, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
