@@ -1,4 +1,3 @@
-#include <limits>
 #include <refit/body/body_surface.hpp>
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
@@ -13,7 +12,9 @@
 #include <refit/pipeline/resize_report.hpp>
 #include <refit/pipeline/units.hpp>
 
+#include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <optional>
 
 namespace refit {
