@@ -118,8 +118,11 @@ TEST(SharedPatterns, DartsBringTheStretchDown) {
   };
   // Issue 16's 0.02 is not reached: the skirt's hip line and the jeans' knees
   // and seat stretch beyond the darts' reach from the waist (docs/patterns.md).
+  // Cut at its sides as a pattern maker would, the skirt gets closer: its front
+  // takes 4 darts, its back halves (0.022) none.
   const DartCase cases[] = {{"skirt", "garments/skirt_on_A_female.obj", nullptr, 0.035},
-                            {"jeans", "garments/jeans_on_A_female.obj", "jeans", 0.09}};
+                            {"jeans", "garments/jeans_on_A_female.obj", "jeans", 0.09},
+                            {"skirt cut at its sides", "garments/skirt_on_A_female.obj", "skirt_side_seams", 0.027}};
   std::printf("| garment | panel | p95 before | p95 with darts | darts | dart lengths | worst seam mismatch |\n");
   for (const DartCase& c : cases) {
     const Garment g = read_garment_obj(data(c.file));
@@ -145,7 +148,10 @@ TEST(SharedPatterns, DartsBringTheStretchDown) {
       std::printf("| %s | %s | %.4f | %.4f | %zu | %s | %.4f |\n", c.garment, cut.panels.panels[k].name.c_str(),
                   before.pieces[k].measures.stretch_p95, after.pieces[k].measures.stretch_p95, count, lengths.c_str(),
                   after.seam_mismatch_max);
-      EXPECT_LT(after.pieces[k].measures.stretch_p95, before.pieces[k].measures.stretch_p95) << c.garment << " " << k;
+      if (count > 0)
+        EXPECT_LT(after.pieces[k].measures.stretch_p95, before.pieces[k].measures.stretch_p95) << c.garment << " " << k;
+      else  // no dart of its own: only its seams' shared lengths moved, and it is no worse for that
+        EXPECT_LE(after.pieces[k].measures.stretch_p95, before.pieces[k].measures.stretch_p95 + 0.001) << c.garment << " " << k;
       EXPECT_LE(after.pieces[k].measures.stretch_p95, c.reached) << c.garment << " " << k;
       EXPECT_EQ(after.pieces[k].measures.flipped, 0u) << c.garment << " " << k;
     }
