@@ -280,9 +280,12 @@ def flipped_faces(original, result, faces):
     return int(((np.einsum("fi,fi->f", turned, n1) < 0) & ok).sum())
 
 
-def face_samples(positions, faces):
-    """Points inside every face (the centroid of each fan triangle and three points near its
-    corners' middles), and the face each belongs to."""
+def face_samples(positions, faces, m=5):
+    """Points inside every face and the face each belongs to: per fan triangle the
+    centroids of its subdivision into (m + 1)^2 small triangles pointing the same way
+    (21 points for m = 5). Four points per triangle (the centroid and three near the
+    corners' middles) missed the body poking through coarse faces between them by up
+    to 0.07 cm on the shared garments."""
     tris = []
     owner = []
     for fi, f in enumerate(faces):
@@ -291,7 +294,9 @@ def face_samples(positions, faces):
             owner.append(fi)
     tris = np.asarray(tris)
     owner = np.asarray(owner)
-    bary = np.array([[1 / 3, 1 / 3, 1 / 3], [2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]])
+    n = m + 1
+    bary = np.array([(1.0 - (i + 1 / 3) / n - (j + 1 / 3) / n, (i + 1 / 3) / n, (j + 1 / 3) / n)
+                     for i in range(n) for j in range(n - i)])
     pts = np.einsum("sk,tkd->tsd", bary, positions[tris]).reshape(-1, 3)
     return pts, np.repeat(owner, len(bary))
 
