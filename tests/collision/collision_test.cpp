@@ -238,11 +238,14 @@ TEST(Collision, TheBodyPokingThroughAFaceAwayFromItsCentreIsPushedOutToo) {
       const Index a = Index(i * 6 + k);
       g.faces.push_row(std::array<Index, 4>{a, a + 1, a + 7, a + 6});
     }
-  // Dense points of every face (bilinear), inside the body or not.
+  // Dense points of every face (bilinear), inside the body or not, and the faces with one.
+  std::size_t faces_with_one = 0;
   auto points_inside = [&](const Points& x) {
     std::size_t inside = 0;
+    faces_with_one = 0;
     for (std::size_t f = 0; f < g.faces.rows(); ++f) {
       const auto c = g.faces.row(f);
+      const std::size_t before = inside;
       for (int i = 0; i <= 20; ++i)
         for (int k = 0; k <= 20; ++k) {
           const double u = i / 20.0, v = k / 20.0;
@@ -250,6 +253,7 @@ TEST(Collision, TheBodyPokingThroughAFaceAwayFromItsCentreIsPushedOutToo) {
                          (1 - u) * v * row3(x, c[3]);
           inside += body.inside(p);
         }
+      faces_with_one += inside > before;
     }
     return inside;
   };
@@ -257,11 +261,53 @@ TEST(Collision, TheBodyPokingThroughAFaceAwayFromItsCentreIsPushedOutToo) {
   ASSERT_EQ(measure_penetration(out, body).inside, 0u);
   ASSERT_EQ(count_face_centres_inside(g, out, body), 0u);
   ASSERT_GT(points_inside(out), 0u);
+  // The cap poking through (radius about 1.26 at the grid) reaches the two faces
+  // beside that corner as well: every face with a point inside is counted.
+  EXPECT_EQ(faces_with_one, 3u);
   const CollisionReport r = resolve_penetrations(g, out, body);
-  EXPECT_EQ(r.faces_inside_before, 1u);
+  EXPECT_EQ(r.faces_inside_before, faces_with_one);
   EXPECT_EQ(r.faces_inside_after, 0u);
   EXPECT_EQ(points_inside(out), 0u);
   EXPECT_EQ(measure_sanity(g, out).flipped_faces, 0u);
+}
+
+// A bump of the body smaller than a coarse face's sample spacing: a sphere of
+// radius 1 whose top rises 0.1 through one triangle with 10 cm legs, at a point 1.8 cm
+// or more from every sample, its corners and its centre far off the body.
+struct Bump {
+  BodySurface body{test::icosphere(3, 1.0, Vec3(5.5, -0.9, 2.5))};
+  Garment g;
+  Bump() {
+    g.positions.resize(3, 3);
+    g.positions << 0.0, 0.0, 0.0, 10.0, 0.0, 0.0, 0.0, 0.0, 10.0;
+    g.faces.push_row(std::array<Index, 3>{0, 1, 2});
+  }
+  // The face's point over the bump's top, (5.5, 2.5) on the plane: barycentric (0.2, 0.55, 0.25).
+  Vec3 over_top(const Points& x) const { return 0.2 * row3(x, 0) + 0.55 * row3(x, 1) + 0.25 * row3(x, 2); }
+};
+
+TEST(Collision, ABumpBetweenTheSamplesOfACoarseFaceIsPushedOut) {
+  const Bump b;
+  CollisionOptions o;
+  o.clearance = 0.1;
+  ASSERT_TRUE(b.body.inside(b.over_top(b.g.positions)));
+  // Without probing (probe_radius above the face's size) the samples miss it.
+  CollisionOptions blind = o;
+  blind.probe_radius = 100.0;
+  Points missed = b.g.positions;
+  const CollisionReport r0 = resolve_penetrations(b.g, missed, b.body, blind);
+  EXPECT_EQ(r0.faces_inside_before, 0u);
+  EXPECT_TRUE(b.body.inside(b.over_top(missed)));
+  // Probing the points over the body's vertices (and where its edges cross the
+  // face's sides) finds it, counts it and pushes the face out of the body.
+  Points out = b.g.positions;
+  const CollisionReport r = resolve_penetrations(b.g, out, b.body, o);
+  EXPECT_EQ(r.faces_inside_before, 1u);
+  EXPECT_EQ(r.faces_inside_after, 0u);
+  EXPECT_FALSE(b.body.inside(b.over_top(out)));
+  EXPECT_GE(b.body.signed_distance(b.over_top(out)), 0.0);
+  // ... by what that needs, not a lift of the whole face: its corners move by well under 1 cm.
+  for (Index v = 0; v < 3; ++v) EXPECT_LT((row3(out, v) - row3(b.g.positions, v)).norm(), 1.0) << v;
 }
 
 TEST(Collision, AFaceOnlyItsCornersClearIsStillAsked) {

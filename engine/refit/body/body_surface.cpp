@@ -2,6 +2,7 @@
 // triangles and ray hits; every distance and every inside/outside decision near
 // the surface is made in double on the body's own positions.
 #include <refit/body/body_surface.hpp>
+#include <refit/body/centre_tree.hpp>
 
 #include <refit/core/parallel.hpp>
 
@@ -166,6 +167,8 @@ struct BodySurface::Impl {
   mutable double grid_h = 1.0;
   mutable std::array<long, 3> grid_n = {0, 0, 0};
   double tie_tolerance = 0.0;             // hits closer than this along a ray are one crossing
+  std::unique_ptr<PointTree> vertex_tree;  // the vertices, for near()
+  Csr neighbours;                          // per vertex, the other ends of its edges (sorted)
 
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
@@ -376,6 +379,22 @@ BodySurface::BodySurface(const BodyMesh& body) : impl_(std::make_unique<Impl>())
                                     " but the body has " + std::to_string(nv) + " vertices");
   m.vertices = body.vertices;
   m.triangles = body.triangles;
+  m.vertex_tree = std::make_unique<PointTree>(m.vertices);
+  {
+    std::vector<std::vector<Index>> next(static_cast<std::size_t>(nv));
+    for (const auto& t : m.triangles)
+      for (int k = 0; k < 3; ++k) {
+        next[t[k]].push_back(t[(k + 1) % 3]);
+        next[t[(k + 1) % 3]].push_back(t[k]);
+      }
+    m.neighbours.offsets.assign(1, 0);
+    for (auto& row : next) {
+      std::sort(row.begin(), row.end());
+      row.erase(std::unique(row.begin(), row.end()), row.end());
+      m.neighbours.indices.insert(m.neighbours.indices.end(), row.begin(), row.end());
+      m.neighbours.offsets.push_back(static_cast<Index>(m.neighbours.indices.size()));
+    }
+  }
 
   // Face normals, degenerate triangles, bounding box, signed volume.
   m.face_normal.setZero(nt, 3);
@@ -562,6 +581,24 @@ SignedClosestPoint BodySurface::closest_and_inside(const Vec3& p, double max_dis
   if (!r.inside && d.best_d2 > max_distance * max_distance) d.best_d2 = kInf;
   static_cast<ClosestPoint&>(r) = closest_of(d, impl_->face_normal);
   return r;
+}
+
+void BodySurface::near(const Vec3& p, double radius, Near& out) const {
+  out.vertices.clear();
+  out.edges.clear();
+  if (!(radius > 0.0)) return;
+  const Impl& m = *impl_;
+  std::vector<std::pair<Index, double>> found;
+  m.vertex_tree->within(p, radius * radius, found);
+  std::vector<Index> in;
+  for (const auto& [i, d2] : found) {
+    out.vertices.push_back(row3(m.vertices, i));
+    in.push_back(i);
+  }
+  std::sort(in.begin(), in.end());
+  for (const Index v : in)
+    for (const Index w : m.neighbours.row(v))  // once: from its smaller end, or from its only end within
+      if (v < w || !std::binary_search(in.begin(), in.end(), w)) out.edges.push_back({row3(m.vertices, v), row3(m.vertices, w)});
 }
 
 double BodySurface::signed_distance(const Vec3& p) const {

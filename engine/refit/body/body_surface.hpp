@@ -3,7 +3,9 @@
 // distance and a robust inside test. Thread-safe for queries after construction.
 #include <refit/body/body_mesh.hpp>
 
+#include <array>
 #include <memory>
+#include <vector>
 
 namespace refit {
 
@@ -49,6 +51,14 @@ class BodySurface {
   void prepare_inside_test() const;
   /// Negative inside, positive outside.
   double signed_distance(const Vec3& p) const;
+  /// The body's vertices within `radius` of p (positions, closest first), and
+  /// the edges with an end among them (each once): what can rise through a
+  /// garment face there.
+  struct Near {
+    std::vector<Vec3> vertices;
+    std::vector<std::array<Vec3, 2>> edges;
+  };
+  void near(const Vec3& p, double radius, Near& out) const;
   /// Ray cast: distance along unit dir to the first hit, +inf if none; tri_out gets the triangle.
   double intersect(const Vec3& origin, const Vec3& dir, Index* tri_out = nullptr) const;
 

@@ -32,6 +32,11 @@ struct CollisionOptions {
   double near_band = 1.0;       // garment units: vertices this close to body B (before the step) are lifted off it
   double max_lift = 0.1;        // by at most this beyond what they need (0 band: no limit)
   double face_clearance = 0.05; // garment units: what points inside faces keep from body B
+  /// Garment units: a face wider than this (its farthest corner from its centre)
+  /// also keeps the points of it over body B's vertices nearby clear; a smaller
+  /// face's samples lie too close together for a smooth body to rise between them
+  /// by more than face_clearance.
+  double probe_radius = 0.25;
   int unfold_passes = 20;       // passes that undo a correction turning a face over (see collision.cpp)
   /// Per vertex (or null): vertices the spread of other vertices' corrections
   /// must not move (the corners of the faces the feature curves sit on, so the

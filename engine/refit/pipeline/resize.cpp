@@ -402,6 +402,7 @@ void GarmentBinding::collision_step(const BodySurface& surface_b, bool symmetric
   co.near_band *= per_cm;  // the defaults are in cm
   co.max_lift *= per_cm;
   co.face_clearance *= per_cm;
+  co.probe_radius *= per_cm;
   // The corners of the faces the curves sit on stay where the surface step put them (unless too close themselves).
   std::vector<std::uint8_t> pinned;
   if (!result.features.curves.empty()) {
