@@ -3,6 +3,7 @@
 // the surface is made in double on the body's own positions.
 #include <refit/body/body_surface.hpp>
 #include <refit/body/centre_tree.hpp>
+#include <refit/core/topology.hpp>
 
 #include <refit/core/parallel.hpp>
 
@@ -381,19 +382,10 @@ BodySurface::BodySurface(const BodyMesh& body) : impl_(std::make_unique<Impl>())
   m.triangles = body.triangles;
   m.vertex_tree = std::make_unique<PointTree>(m.vertices);
   {
-    std::vector<std::vector<Index>> next(static_cast<std::size_t>(nv));
-    for (const auto& t : m.triangles)
-      for (int k = 0; k < 3; ++k) {
-        next[t[k]].push_back(t[(k + 1) % 3]);
-        next[t[(k + 1) % 3]].push_back(t[k]);
-      }
-    m.neighbours.offsets.assign(1, 0);
-    for (auto& row : next) {
-      std::sort(row.begin(), row.end());
-      row.erase(std::unique(row.begin(), row.end()), row.end());
-      m.neighbours.indices.insert(m.neighbours.indices.end(), row.begin(), row.end());
-      m.neighbours.offsets.push_back(static_cast<Index>(m.neighbours.indices.size()));
-    }
+    Garment surface;  // the body's triangles as faces, for the garments' vertex adjacency
+    surface.positions = m.vertices;
+    for (const auto& t : m.triangles) surface.faces.push_row(t);
+    m.neighbours = vertex_adjacency(surface);
   }
 
   // Face normals, degenerate triangles, bounding box, signed volume.

@@ -191,8 +191,8 @@ bool face_needs(const Garment& g, const Points& positions, std::size_t f, const 
       const auto p0 = over(e[0]), p1 = over(e[1]);
       // The sides s = 0, t = 0 and s + t = 1, each as g(s, t) = 0 with the
       // triangle on g >= 0: the edge crosses a side where g changes sign.
-      const std::array<std::array<double, 3>, 3> sides = {{{1, 0, 0}, {0, 1, 0}, {-1, -1, 1}}};
-      for (const auto& g : sides) {
+      static constexpr double kSides[3][3] = {{1, 0, 0}, {0, 1, 0}, {-1, -1, 1}};
+      for (const auto& g : kSides) {
         const double g0 = g[0] * p0[0] + g[1] * p0[1] + g[2], g1 = g[0] * p1[0] + g[1] * p1[1] + g[2];
         if ((g0 > 0.0) == (g1 > 0.0) || g0 == g1) continue;
         const double u = g0 / (g0 - g1);
