@@ -59,6 +59,11 @@ CHECK = {"F_heavier_taller": ("A_female", {"F_heavier": 1.0, "F_taller": 1.0}),
          "F_heaviest": ("A_female", {"F_heavier": 1.6}),
          "F_thinnest": ("A_female", {"F_thinner": 1.5}),
          "M_heaviest": ("M_ref", {"M_heavier": 1.6})}
+# Dense garments (--dense), made here with the shared data's make_dense.py (midpoint
+# subdivision: the same shape, faces of about 0.4 cm): the warp crumples a garment
+# at a scale below body A's triangles (under the arms), which the coarse garments'
+# 2 cm faces never show. Their features are the coarse garment's (planes and points).
+DENSE = {"dress_dense": ("dress", 100000)}
 DERIVED_DIR = None  # where main() writes them
 QUICK = (["skirt", "dress"], ["F_heavier", "F_thinner"])
 # Features: the hem and a front and a left profile (one side only: the garment must
@@ -147,13 +152,15 @@ class Case:
     def __init__(self, data, garment, target):
         self.garment = garment
         self.target = target
-        file, self.body_a_name, self.spec = GARMENTS[garment]
-        self.garment_path = os.path.join(data, "garments", file)
+        source = DENSE[garment][0] if garment in DENSE else garment
+        file, self.body_a_name, self.spec = GARMENTS[source]
+        self.garment_path = (os.path.join(DERIVED_DIR, garment + ".obj") if garment in DENSE
+                             else os.path.join(data, "garments", file))
         self.a_path = os.path.join(data, "bodies", self.body_a_name + ".obj")
         made = target in DERIVED or target in CHECK
         self.b_path = os.path.join(DERIVED_DIR if made else os.path.join(data, "bodies"), target + ".obj")
         self.peer_path = os.path.join(data, "peer_makehuman", "%s__%s.obj" % (garment, target))
-        self.features_path = os.path.join(HERE, "features", garment + ".json") if self.spec else None
+        self.features_path = os.path.join(HERE, "features", source + ".json") if self.spec else None
 
 
 def write_derived_bodies(data, out_dir):
@@ -336,6 +343,8 @@ def main():
     ap.add_argument("--quick", action="store_true", help="skirt and dress on F_heavier and F_thinner")
     ap.add_argument("--check-bodies", action="store_true",
                     help="the bodies of CHECK instead (blends of the shared bodies, made here)")
+    ap.add_argument("--dense", action="store_true",
+                    help="also the garments of DENSE (the dress subdivided to 135k vertices; slower to score)")
     ap.add_argument("--out", default=None)
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--json", default=None)
@@ -363,10 +372,17 @@ def main():
     DERIVED_DIR = out_dir
     write_derived_bodies(data, out_dir)
     garments, bodies = (QUICK if args.quick else (args.garments, args.bodies))
+    if args.dense:
+        for name, (source, vertices) in DENSE.items():
+            subprocess.run([sys.executable, os.path.join(data, "make_dense.py"), os.path.join(data, "garments", GARMENTS[source][0]),
+                            os.path.join(out_dir, name + ".obj"), "--min-vertices", str(vertices)], check=True,
+                           capture_output=True)
+        garments = list(garments) + list(DENSE)
     targets = TARGETS
     if args.check_bodies:
         targets = {a: [t for t, (base, _) in CHECK.items() if base == a] for a in TARGETS}
-    cases = [Case(data, g, t) for g in garments for t in targets[GARMENTS[g][1]] if not bodies or t in bodies]
+    body_a = lambda g: GARMENTS[DENSE[g][0] if g in DENSE else g][1]
+    cases = [Case(data, g, t) for g in garments for t in targets[body_a(g)] if not bodies or t in bodies]
     results = []
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
         for case, rows in pool.map(lambda c: evaluate(args, c, out_dir), cases):

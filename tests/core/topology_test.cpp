@@ -246,5 +246,15 @@ TEST(Topology, LargeGridSameForOneAndTwoThreadsAndMatchesAPlainCount) {
   expect_valid_loops(g, loops_one);
 }
 
+TEST(Topology, VertexFacesListEachCornersFacesOnceInOrder) {
+  // Two triangles and a quad with a repeated corner; vertex 5 is only on a line.
+  const Garment g = make(6, {{0, 1, 2}, {2, 1, 3}, {3, 4, 4, 1}}, {{4, 5}});
+  const Csr vf = vertex_faces(g);
+  ASSERT_EQ(vf.rows(), 6u);
+  const std::vector<std::vector<Index>> expected = {{0}, {0, 1, 2}, {0, 1}, {1, 2}, {2}, {}};
+  for (std::size_t v = 0; v < 6; ++v)
+    EXPECT_EQ(std::vector<Index>(vf.row(v).begin(), vf.row(v).end()), expected[v]) << v;
+}
+
 }  // namespace
 }  // namespace refit

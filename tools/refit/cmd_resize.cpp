@@ -32,7 +32,7 @@ struct ResizeArgs {
   std::vector<std::string> to_outputs;  // with --to-list: the output of each body of `to`
   std::size_t threads = 0, max_triangles = WarpOptions{}.max_triangles;
   bool quiet = false, metrics = false, paper_closeness = false, no_shape_control = false, no_collision = false,
-       encode_on_warped = false, paper_surface = false, plain_sweeps = false, v_cycles = false,
+       encode_on_warped = false, paper_surface = false, keep_folds = false, plain_sweeps = false, v_cycles = false,
        ordered_features = false;
   SurfaceOptions surface;
   double clearance = 0.2;
@@ -229,6 +229,7 @@ int run(ResizeArgs a) {
     options.surface.follow_body_scale = false;
   }
   options.collision = !(a.no_collision || paper);
+  options.smooth_folds = !a.keep_folds;
   options.symmetry = parse_symmetry(!a.symmetry.empty() ? a.symmetry : paper ? "none" : "auto");
   options.metrics = a.metrics;
   options.clearance_cm = a.clearance;
@@ -442,6 +443,10 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
                  "auto: mirror each one-sided feature about x = c when garment and body A are mirror-symmetric; "
                  "x: always; none: never (default: auto; none with --method paper; docs/features.md)");
   app.add_flag("--no-collision", a->no_collision, "Do not push vertices inside body B out");
+  app.add_flag("--keep-folds", a->keep_folds,
+               "In the collision step, leave the faces the warp folded over (under the arms of a dense garment) as they are "
+               "instead of smoothing them out first (docs/method.md)")
+      ->group(kAdvanced);
   app.add_option("--clearance", a->clearance, "Collision clearance outside body B in cm (0 to 10)")
       ->check(check_clearance)
       ->capture_default_str();

@@ -320,4 +320,24 @@ Csr vertex_adjacency(const Garment& g) {
   return adj;
 }
 
+Csr vertex_faces(const Garment& g) {
+  const std::size_t n = g.vertex_count();
+  std::vector<Index> start;
+  UninitVector<Index> all;
+  sorted_buckets(
+      n, g.faces.rows(),
+      [&](std::size_t b, std::size_t e, auto&& put) {
+        for (std::size_t f = b; f < e; ++f) {
+          const auto row = g.faces.row(f);
+          for (std::size_t k = 0; k < row.size(); ++k)
+            if (std::find(row.begin(), row.begin() + k, row[k]) == row.begin() + k) put(row[k], Index(f));
+        }
+      },
+      start, all);
+  Csr out;
+  out.offsets.assign(start.begin(), start.end());
+  out.indices = std::move(all);
+  return out;
+}
+
 }  // namespace refit

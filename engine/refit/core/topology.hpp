@@ -38,4 +38,7 @@ std::vector<Index> boundary_vertices(const Garment& g, const std::vector<Index>&
 /// Vertex adjacency (CSR, sorted, no duplicates) from faces and `l` lines.
 Csr vertex_adjacency(const Garment& g);
 
+/// Per vertex, the faces it is a corner of (CSR, ascending, each face once).
+Csr vertex_faces(const Garment& g);
+
 }  // namespace refit

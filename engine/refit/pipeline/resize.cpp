@@ -292,6 +292,11 @@ const Csr& GarmentBinding::vertex_adjacency_once() const {
   return adjacency_;
 }
 
+const FoldBinding& GarmentBinding::folds_once() const {
+  std::call_once(folds_once_, [&] { folds_ = bind_folds(*garment_); });
+  return folds_;
+}
+
 // A symmetric pair gives a symmetric garment: each paired vertex halfway to its partner's mirror image.
 void GarmentBinding::symmetrise_garment(Points& positions) const {
   const Points mirrored = mirror_x(carry(garment_mirror_, positions), mirror_x_);
@@ -409,15 +414,27 @@ void GarmentBinding::collision_step(const BodySurface& surface_b, bool symmetric
     pinned = feature_corners(feature_attachment_, result.positions.rows());
     co.pinned = &pinned;
   }
+  // Folds first: the smoothing may move vertices towards the body, the pushes then clear them.
+  const Csr& adjacency = vertex_adjacency_once();
+  nlohmann::json folds_report;
+  if (options_.smooth_folds) {
+    const Stopwatch folds_clock;
+    const FoldReport folds =
+        smooth_out_folds(*garment_, folds_once(), result.positions, adjacency, pinned.empty() ? nullptr : &pinned);
+    folds_report = {{"folded", folds.folded_before}, {"left", folds.folded_after}, {"smoothed", folds.smoothed},
+                    {"rounds", folds.rounds}};
+    result.report["timings_ms"]["collision_folds"] = folds_clock.ms();  // part of the collision step's
+  }
   const Points before = symmetric_b ? result.positions : Points();
   if (symmetric_b)
     co.symmetrise = [&](const Points& now) {
       return symmetric_pushes(before, now, kSymmetricPushToleranceCm * per_cm, co.max_lift);
     };
-  co.adjacency = &vertex_adjacency_once();
+  co.adjacency = &adjacency;
   const CollisionReport c = resolve_penetrations(*garment_, result.positions, surface_b, co);
   result.report["timings_ms"]["collision"] = clock.ms();
   result.report["collision"] = c.to_json();
+  if (!folds_report.is_null()) result.report["collision"]["folds"] = folds_report;
   if (c.inside_after > 0)
     result.warnings.push_back(std::to_string(c.inside_after) + " vertices are still inside body B after collision resolution");
 }

@@ -16,6 +16,7 @@
 #include <refit/features/shape_matching.hpp>
 #include <refit/features/symmetry.hpp>
 #include <refit/metrics/metrics.hpp>
+#include <refit/surface/folds.hpp>
 #include <refit/surface/surface.hpp>
 #include <refit/warp/warp.hpp>
 
@@ -49,6 +50,7 @@ struct ResizeOptions {
   double symmetry_tolerance_cm = 1.0;          // Auto: largest mirror error (95th percentile) of garment and body A
   SurfaceOptions surface;      // epsilon and voxel in cm here; converted to garment units
   bool collision = true;       // push vertices inside body B out (beyond the paper)
+  bool smooth_folds = true;    // the collision step first smooths out the faces the warp folded over (surface/folds.hpp)
   double clearance_cm = 0.2;   // ... to this distance outside the body
   /// With the collision step: feature samples the warp leaves within this of
   /// body B keep the warp's distance to it, to kFeatureFollowToleranceCm
@@ -107,6 +109,7 @@ class GarmentBinding {
   void metrics_step(const BodySurface& surface_b, ResizeResult& result, const Progress& progress) const;
   void symmetrise_garment(Points& positions) const;
   const Csr& vertex_adjacency_once() const;
+  const FoldBinding& folds_once() const;
 
   std::shared_ptr<const Garment> garment_;
   ResizeOptions options_;
@@ -128,6 +131,9 @@ class GarmentBinding {
   // it (so a single body's peak memory is as before), kept for the next bodies.
   mutable std::once_flag adjacency_once_;
   mutable Csr adjacency_;
+  // The same for the fold smoothing's faces of each vertex and faces agreeing on the original.
+  mutable std::once_flag folds_once_;
+  mutable FoldBinding folds_;
 };
 
 /// The surface step's options in garment units: `options.surface` keeps epsilon

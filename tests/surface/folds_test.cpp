@@ -1,0 +1,133 @@
+// The fold smoothing (surface/folds.hpp): faces turned over against their
+// neighbours are smoothed out; a smooth deformation and pinned vertices are left alone.
+#include <refit/core/topology.hpp>
+#include <refit/surface/folds.hpp>
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+
+namespace refit {
+namespace {
+
+constexpr int kSide = 21;        // vertices per side
+constexpr double kSpacing = 0.5;
+
+// A flat kSide x kSide grid of triangles in the plane y = 0.
+Garment grid() {
+  Garment g;
+  g.positions.resize(kSide * kSide, 3);
+  for (int i = 0; i < kSide; ++i)
+    for (int k = 0; k < kSide; ++k) g.positions.row(i * kSide + k) << kSpacing * i, 0.0, kSpacing * k;
+  for (int i = 0; i + 1 < kSide; ++i)
+    for (int k = 0; k + 1 < kSide; ++k) {
+      const Index a = Index(i * kSide + k);
+      g.faces.push_row(std::array<Index, 3>{a, a + 1, a + kSide + 1});
+      g.faces.push_row(std::array<Index, 3>{a, a + kSide + 1, a + kSide});
+    }
+  return g;
+}
+
+// A smooth deformation: a 30 degree turn about x and a 10 % stretch along x.
+Eigen::Matrix3d smooth_map() {
+  return Eigen::AngleAxisd(M_PI / 6.0, Vec3::UnitX()).toRotationMatrix() * Eigen::Vector3d(1.1, 1.0, 1.0).asDiagonal();
+}
+
+// Faces whose normal points against the smooth map's image of their original
+// normal: folds, counted without the code under test.
+std::size_t folds_against(const Garment& g, const Points& positions, const Eigen::Matrix3d& map) {
+  std::size_t n = 0;
+  for (std::size_t f = 0; f < g.faces.rows(); ++f) {
+    const auto face = g.faces.row(f);
+    auto normal = [&](const Points& p) {
+      return Vec3((row3(p, face[1]) - row3(p, face[0])).cross(row3(p, face[2]) - row3(p, face[0])));
+    };
+    const Vec3 expected = map.inverse().transpose() * normal(g.positions);  // normals map by the inverse transpose
+    if (normal(positions).dot(expected) <= 0.0) ++n;
+  }
+  return n;
+}
+
+Points deformed(const Garment& g, const Eigen::Matrix3d& map) {
+  Points p = g.positions;
+  for (Index v = 0; v < p.rows(); ++v) p.row(v) = (map * row3(g.positions, v)).transpose();
+  return p;
+}
+
+constexpr Index kCentre = Index(10 * kSide + 10);
+
+// The smooth deformation with the centre vertex pushed about 2.4 spacings along the
+// grid (its image): the faces on that side turn over.
+Points crumpled(const Garment& g, const Eigen::Matrix3d& map) {
+  Points p = deformed(g, map);
+  p.row(kCentre) += (map * Vec3(2.0 * kSpacing, 0.0, 1.3 * kSpacing)).transpose();
+  return p;
+}
+
+TEST(Folds, ASmoothDeformationIsLeftAlone) {
+  const Garment g = grid();
+  const Csr adjacency = vertex_adjacency(g);
+  const FoldBinding binding = bind_folds(g);
+  Points p = deformed(g, smooth_map());
+  const Points before = p;
+  const FoldReport r = smooth_out_folds(g, binding, p, adjacency, nullptr);
+  EXPECT_EQ(r.folded_before, 0u);
+  EXPECT_EQ(r.smoothed, 0u);
+  EXPECT_TRUE(p == before);
+}
+
+TEST(Folds, ACrumpleIsSmoothedOutAndTheRestKept) {
+  const Garment g = grid();
+  const Eigen::Matrix3d map = smooth_map();
+  const Csr adjacency = vertex_adjacency(g);
+  const FoldBinding binding = bind_folds(g);
+  Points p = crumpled(g, map);
+  const std::size_t folded = folds_against(g, p, map);
+  ASSERT_GE(folded, 2u);
+  const FoldReport r = smooth_out_folds(g, binding, p, adjacency, nullptr);
+  EXPECT_GE(r.folded_before, 1u);
+  EXPECT_EQ(r.folded_after, 0u);
+  EXPECT_EQ(folds_against(g, p, map), 0u);
+  // Only the neighbourhood of the crumple moved; the grid's edge kept the smooth map exactly.
+  EXPECT_GT(r.smoothed, 0u);
+  EXPECT_LT(r.smoothed, std::size_t(kSide * kSide / 4));
+  const Points smooth = deformed(g, map);
+  for (int i = 0; i < kSide; ++i)
+    for (Index v : {Index(i), Index(i * kSide), Index(i * kSide + kSide - 1), Index((kSide - 1) * kSide + i)})
+      EXPECT_TRUE(p.row(v) == smooth.row(v)) << v;
+}
+
+TEST(Folds, PinnedVerticesKeepTheirPlace) {
+  const Garment g = grid();
+  const Eigen::Matrix3d map = smooth_map();
+  const Csr adjacency = vertex_adjacency(g);
+  const FoldBinding binding = bind_folds(g);
+  Points p = crumpled(g, map);
+  std::vector<std::uint8_t> pinned(g.vertex_count(), 0);
+  pinned[kCentre] = 1;
+  const Vec3 centre = row3(p, kCentre);
+  const std::size_t folded = folds_against(g, p, map);
+  const FoldReport r = smooth_out_folds(g, binding, p, adjacency, &pinned);
+  EXPECT_TRUE(row3(p, kCentre) == centre);
+  EXPECT_LE(folds_against(g, p, map), folded);
+  EXPECT_LE(r.folded_after, r.folded_before);
+}
+
+TEST(Folds, NothingChangesWhenSmoothingCannotHelp) {
+  // Every vertex pinned: no round gets better, so none is kept.
+  const Garment g = grid();
+  const Csr adjacency = vertex_adjacency(g);
+  const FoldBinding binding = bind_folds(g);
+  Points p = crumpled(g, smooth_map());
+  const Points before = p;
+  const std::vector<std::uint8_t> pinned(g.vertex_count(), 1);
+  const FoldReport r = smooth_out_folds(g, binding, p, adjacency, &pinned);
+  EXPECT_GE(r.folded_before, 1u);
+  EXPECT_EQ(r.folded_after, r.folded_before);
+  EXPECT_EQ(r.smoothed, 0u);
+  EXPECT_TRUE(p == before);
+}
+
+}  // namespace
+}  // namespace refit
