@@ -8,14 +8,16 @@ Blender's Surface Deform, scored from the written files by bench/quality/meshes.
     /usr/bin/python3 bench/quality/run.py --refit build/release/tools/refit [--quick]
         [--garments skirt dress ...] [--bodies F_heavier ...] [--methods refit warp makehuman blender]
         [--data ../shared/data] [--out DIR] [--jobs 2] [--json R.json] [--refit-args "--no-collision"]
-        [--assert] [--check-bodies]
+        [--assert] [--check-bodies] [--dense]
 
 Prints one Markdown row per garment, body and method, then the worst figure of each
 method against issue 13's targets. With --assert, exits 1 when Refit misses a target
 listed in ASSERTED (the ones the engine holds today; CTest runs --quick --assert).
 Exits 77 (CTest's skip) when the shared data is absent. --check-bodies runs the same on
 bodies made here from the shared ones (CHECK: combined and stronger morphs), to see
-whether what holds on the shared bodies holds off them.
+whether what holds on the shared bodies holds off them. --dense adds the garments of
+DENSE (the dress split to 135k vertices by the shared data's make_dense.py), where the
+warp's folds under the arms show (about 6 minutes more: scoring is per face).
 """
 import argparse
 import concurrent.futures

@@ -65,64 +65,65 @@ Points crumpled(const Garment& g, const Eigen::Matrix3d& map) {
   return p;
 }
 
+// The grid, what the smoothing needs of it, and the smooth map.
+struct Grid {
+  Garment g = grid();
+  Csr adjacency = vertex_adjacency(g);
+  FoldBinding binding = bind_folds(g);
+  Eigen::Matrix3d map = smooth_map();
+
+  FoldReport smooth(Points& p, const std::vector<std::uint8_t>* pinned = nullptr) const {
+    return smooth_out_folds(g, binding, p, adjacency, pinned);
+  }
+};
+
 TEST(Folds, ASmoothDeformationIsLeftAlone) {
-  const Garment g = grid();
-  const Csr adjacency = vertex_adjacency(g);
-  const FoldBinding binding = bind_folds(g);
-  Points p = deformed(g, smooth_map());
+  const Grid grid;
+  Points p = deformed(grid.g, grid.map);
   const Points before = p;
-  const FoldReport r = smooth_out_folds(g, binding, p, adjacency, nullptr);
+  const FoldReport r = grid.smooth(p);
   EXPECT_EQ(r.folded_before, 0u);
   EXPECT_EQ(r.smoothed, 0u);
   EXPECT_TRUE(p == before);
 }
 
 TEST(Folds, ACrumpleIsSmoothedOutAndTheRestKept) {
-  const Garment g = grid();
-  const Eigen::Matrix3d map = smooth_map();
-  const Csr adjacency = vertex_adjacency(g);
-  const FoldBinding binding = bind_folds(g);
-  Points p = crumpled(g, map);
-  const std::size_t folded = folds_against(g, p, map);
-  ASSERT_GE(folded, 2u);
-  const FoldReport r = smooth_out_folds(g, binding, p, adjacency, nullptr);
+  const Grid grid;
+  Points p = crumpled(grid.g, grid.map);
+  ASSERT_GE(folds_against(grid.g, p, grid.map), 2u);
+  const FoldReport r = grid.smooth(p);
   EXPECT_GE(r.folded_before, 1u);
   EXPECT_EQ(r.folded_after, 0u);
-  EXPECT_EQ(folds_against(g, p, map), 0u);
+  EXPECT_EQ(folds_against(grid.g, p, grid.map), 0u);
   // Only the neighbourhood of the crumple moved; the grid's edge kept the smooth map exactly.
   EXPECT_GT(r.smoothed, 0u);
   EXPECT_LT(r.smoothed, std::size_t(kSide * kSide / 4));
-  const Points smooth = deformed(g, map);
+  const Points smooth = deformed(grid.g, grid.map);
   for (int i = 0; i < kSide; ++i)
     for (Index v : {Index(i), Index(i * kSide), Index(i * kSide + kSide - 1), Index((kSide - 1) * kSide + i)})
       EXPECT_TRUE(p.row(v) == smooth.row(v)) << v;
 }
 
 TEST(Folds, PinnedVerticesKeepTheirPlace) {
-  const Garment g = grid();
-  const Eigen::Matrix3d map = smooth_map();
-  const Csr adjacency = vertex_adjacency(g);
-  const FoldBinding binding = bind_folds(g);
-  Points p = crumpled(g, map);
-  std::vector<std::uint8_t> pinned(g.vertex_count(), 0);
+  const Grid grid;
+  Points p = crumpled(grid.g, grid.map);
+  std::vector<std::uint8_t> pinned(grid.g.vertex_count(), 0);
   pinned[kCentre] = 1;
   const Vec3 centre = row3(p, kCentre);
-  const std::size_t folded = folds_against(g, p, map);
-  const FoldReport r = smooth_out_folds(g, binding, p, adjacency, &pinned);
+  const std::size_t folded = folds_against(grid.g, p, grid.map);
+  const FoldReport r = grid.smooth(p, &pinned);
   EXPECT_TRUE(row3(p, kCentre) == centre);
-  EXPECT_LE(folds_against(g, p, map), folded);
+  EXPECT_LE(folds_against(grid.g, p, grid.map), folded);
   EXPECT_LE(r.folded_after, r.folded_before);
 }
 
 TEST(Folds, NothingChangesWhenSmoothingCannotHelp) {
   // Every vertex pinned: no round gets better, so none is kept.
-  const Garment g = grid();
-  const Csr adjacency = vertex_adjacency(g);
-  const FoldBinding binding = bind_folds(g);
-  Points p = crumpled(g, smooth_map());
+  const Grid grid;
+  Points p = crumpled(grid.g, grid.map);
   const Points before = p;
-  const std::vector<std::uint8_t> pinned(g.vertex_count(), 1);
-  const FoldReport r = smooth_out_folds(g, binding, p, adjacency, &pinned);
+  const std::vector<std::uint8_t> pinned(grid.g.vertex_count(), 1);
+  const FoldReport r = grid.smooth(p, &pinned);
   EXPECT_GE(r.folded_before, 1u);
   EXPECT_EQ(r.folded_after, r.folded_before);
   EXPECT_EQ(r.smoothed, 0u);
