@@ -89,7 +89,7 @@ TARGET_TEXT = {
 }
 # Face interiors since the collision step probes a coarse face's points over body B's
 # vertices (2026-11-27): 0 in all 22 cases, scored at 21 points per fan triangle.
-ASSERTED = ["inside_vertices", "inside_faces"]
+ASSERTED = ["flipped", "inside_vertices", "inside_faces"]
 # A face of the input this far inside body A (cm) marks its corners: see input_sunk.
 INPUT_SUNK_CM = 0.1
 
