@@ -171,7 +171,7 @@ TEST(Collision, WhatTheSymmetrisationHookLeavesInsideIsPushedOutAgain) {
   CollisionOptions o;
   int calls = 0;
   std::size_t undone = 0;
-  o.symmetrise = [&](const Points& now) {
+  o.after_rounds = [&](const Points& now) {
     ++calls;
     std::vector<std::pair<Index, Vec3>> moves;
     for (Index i = 0; i < now.rows(); ++i)

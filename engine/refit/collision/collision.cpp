@@ -485,12 +485,12 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   const int max_rounds = std::max(1, options.max_rounds);
   for (int round = 0; round < max_rounds; ++round)
     if (!correction_round(round == 0, round + 1 == max_rounds)) break;
-  // With options.symmetrise: its new positions, then one more round over what it
+  // With options.after_rounds: its new positions, then one more round over what it
   // moved. One: on the real garments of the quality suite 1, 2 or 5 give the
   // same figures, and on the 1M dress the step took 2.7 s with 1 and 3.2 s with 5.
-  if (options.symmetrise) {
+  if (options.after_rounds) {
     to_check.clear();
-    for (const auto& [i, p] : options.symmetrise(positions)) {
+    for (const auto& [i, p] : options.after_rounds(positions)) {
       touch(i);
       positions.row(i) = p.transpose();
       outside_by[i] = 0.0;

@@ -44,10 +44,11 @@ struct CollisionOptions {
   /// itself inside body B or too close still moves out.
   const std::vector<std::uint8_t>* pinned = nullptr;
   /// Optional: after the rounds, new positions for some vertices (given the
-  /// positions then), e.g. both sides of a mirror-symmetric garment moved alike;
+  /// positions then), e.g. both sides of a mirror-symmetric garment moved alike,
+  /// or the folds the pushes made smoothed out;
   /// the rounds then run again over those vertices, so what it leaves too close
   /// is pushed out by what it still needs.
-  std::function<std::vector<std::pair<Index, Vec3>>(const Points& positions)> symmetrise;
+  std::function<std::vector<std::pair<Index, Vec3>>(const Points& positions)> after_rounds;
   /// Optional: the garment's vertex_adjacency (core/topology.hpp), for a caller
   /// that resolves one garment on many bodies (on a 1M garment it takes 0.1 s
   /// to make); null: made here.

@@ -416,25 +416,49 @@ void GarmentBinding::collision_step(const BodySurface& surface_b, bool symmetric
   }
   // Folds first: the smoothing may move vertices towards the body, the pushes then clear them.
   const Csr& adjacency = vertex_adjacency_once();
-  nlohmann::json folds_report;
+  const std::vector<std::uint8_t>* keep = pinned.empty() ? nullptr : &pinned;
+  FoldReport folds, folds_after;
+  double folds_ms = 0.0;
   if (options_.smooth_folds) {
     const Stopwatch folds_clock;
-    const FoldReport folds =
-        smooth_out_folds(*garment_, folds_once(), result.positions, adjacency, pinned.empty() ? nullptr : &pinned);
-    folds_report = {{"folded", folds.folded_before}, {"left", folds.folded_after}, {"smoothed", folds.smoothed},
-                    {"rounds", folds.rounds}};
-    result.report["timings_ms"]["collision_folds"] = folds_clock.ms();  // part of the collision step's
+    folds = smooth_out_folds(*garment_, folds_once(), result.positions, adjacency, keep);
+    folds_ms += folds_clock.ms();
   }
+  // After the rounds: both sides of a symmetric pair pushed alike, and the folds
+  // the pushes made smoothed out (made alike too); one more round clears what that moved.
   const Points before = symmetric_b ? result.positions : Points();
-  if (symmetric_b)
-    co.symmetrise = [&](const Points& now) {
-      return symmetric_pushes(before, now, kSymmetricPushToleranceCm * per_cm, co.max_lift);
+  auto alike = [&](const Points& now) { return symmetric_pushes(before, now, kSymmetricPushToleranceCm * per_cm, co.max_lift); };
+  if (symmetric_b || options_.smooth_folds)
+    co.after_rounds = [&](const Points& now) {
+      std::vector<std::pair<Index, Vec3>> moves;
+      if (symmetric_b) moves = alike(now);
+      if (!options_.smooth_folds) return moves;
+      const Stopwatch folds_clock;
+      Points p = now;
+      for (const auto& [i, q] : moves) p.row(i) = q.transpose();
+      folds_after = smooth_out_folds(*garment_, folds_once(), p, adjacency, keep);
+      if (folds_after.smoothed > 0) {
+        if (symmetric_b)
+          for (const auto& [i, q] : alike(p)) p.row(i) = q.transpose();
+        moves.clear();
+        for (Index i = 0; i < p.rows(); ++i)
+          if (p.row(i) != now.row(i)) moves.emplace_back(i, row3(p, i));
+      }
+      folds_ms += folds_clock.ms();
+      return moves;
     };
   co.adjacency = &adjacency;
   const CollisionReport c = resolve_penetrations(*garment_, result.positions, surface_b, co);
   result.report["timings_ms"]["collision"] = clock.ms();
   result.report["collision"] = c.to_json();
-  if (!folds_report.is_null()) result.report["collision"]["folds"] = folds_report;
+  if (options_.smooth_folds) {
+    auto figures = [](const FoldReport& f) {
+      return nlohmann::json{{"folded", f.folded_before}, {"left", f.folded_after}, {"smoothed", f.smoothed}, {"rounds", f.rounds}};
+    };
+    result.report["collision"]["folds"] = figures(folds);
+    result.report["collision"]["folds"]["after_pushes"] = figures(folds_after);
+    result.report["timings_ms"]["collision_folds"] = folds_ms;  // part of the collision step's
+  }
   if (c.inside_after > 0)
     result.warnings.push_back(std::to_string(c.inside_after) + " vertices are still inside body B after collision resolution");
 }

@@ -10,6 +10,10 @@ namespace refit {
 namespace {
 
 constexpr std::size_t kGrain = 4096;
+// A face counts as agreeing on the original only within 60 degrees of its
+// corners' normals: not at a crease (a collar's, a lapel's), where turning it
+// the other way is no fold.
+constexpr double kSmoothAround = 0.5;
 
 // Newell normal of face f (twice its area, for a planar face); zero for points and lines.
 Vec3 face_normal(const Garment& g, const Points& positions, std::size_t f) {
@@ -41,10 +45,11 @@ struct Orientation {
     for (Index f : faces_of_vertex.row(v)) s += face[f];
     return s;
   }
-  bool agrees(std::size_t f) const {
+  // Whether face f's normal is within the angle whose cosine is `cos_min` of the sum of its corners' normals.
+  bool agrees(std::size_t f, double cos_min = 0.0) const {
     Vec3 around = Vec3::Zero();
     for (Index v : g.faces.row(f)) around += vertex[v];
-    return face[f].squaredNorm() > 0.0 && face[f].dot(around) > 0.0;
+    return face[f].squaredNorm() > 0.0 && face[f].dot(around) > cos_min * face[f].norm() * around.norm();
   }
   // After the vertices `moved` moved: their faces' normals and their corners'
   // sums again; returns the faces whose verdict may have changed (in no order),
@@ -77,7 +82,7 @@ std::vector<std::uint8_t> faces_agreeing(const Garment& g, const Csr& faces_of_v
   const Orientation o(g, faces_of_vertex, positions);
   std::vector<std::uint8_t> agrees(g.faces.rows(), 0);
   parallel_for(0, agrees.size(), kGrain, [&](std::size_t b, std::size_t e) {
-    for (std::size_t f = b; f < e; ++f) agrees[f] = o.agrees(f);
+    for (std::size_t f = b; f < e; ++f) agrees[f] = o.agrees(f, kSmoothAround);
   });
   return agrees;
 }
