@@ -32,11 +32,11 @@ struct FoldBinding {
   std::vector<std::uint8_t> agrees;   // per face: faces_agreeing on the original
 };
 
-/// Per face: whether its normal agrees with the sum of its corners' vertex
-/// normals (the sums of their faces' area-weighted normals) (1) or points
-/// against it (0; also degenerate faces). A face that agrees on the original and
-/// not on a result is folded over against its neighbours. `faces_of_vertex`:
-/// vertex_faces(g).
+/// Per face: whether its normal lies within 60 degrees of the sum of its
+/// corners' vertex normals (the sums of their faces' area-weighted normals) (1)
+/// or not (0; also degenerate faces): a face away from a crease. A face that
+/// agrees on the original and whose normal points against that sum on a result is
+/// folded over against its neighbours. `faces_of_vertex`: vertex_faces(g).
 std::vector<std::uint8_t> faces_agreeing(const Garment& g, const Csr& faces_of_vertex, const Points& positions);
 
 FoldBinding bind_folds(const Garment& g);
