@@ -6,6 +6,7 @@
 #include <refit/core/types.hpp>
 
 #include <memory>
+#include <span>
 #include <string>
 
 namespace refit {
@@ -21,5 +22,13 @@ struct Garment {
 
   std::size_t vertex_count() const { return static_cast<std::size_t>(positions.rows()); }
 };
+
+/// Newell normal of a face (twice its area for a planar face, not normalised;
+/// zero for a degenerate face or fewer than 3 corners' worth of area).
+inline Vec3 face_normal(const Points& positions, std::span<const Index> face) {
+  Vec3 n = Vec3::Zero();
+  for (std::size_t k = 0; k < face.size(); ++k) n += row3(positions, face[k]).cross(row3(positions, face[(k + 1) % face.size()]));
+  return n;
+}
 
 }  // namespace refit

@@ -116,13 +116,7 @@ std::vector<std::uint8_t> recompute_normals(const Garment& g, const Points& x, c
   normals = Points::Zero(static_cast<Eigen::Index>(nn), 3);
   std::vector<std::uint8_t> used(nn, 0);
   for (std::size_t f = 0; f < g.faces.rows(); ++f) {
-    const auto row = g.faces.row(f);
-    Vec3 n = Vec3::Zero();
-    for (std::size_t k = 0; k < row.size(); ++k) {
-      const Vec3 a = row3(x, row[k]);
-      const Vec3 b = row3(x, row[(k + 1) % row.size()]);
-      n += a.cross(b);
-    }
+    const Vec3 n = face_normal(x, g.faces.row(f));
     for (std::size_t k = g.faces.offsets[f]; k < g.faces.offsets[f + 1]; ++k) {
       const Index ni = s.corner_normals[k];
       if (ni == ObjSource::kNoNormal) continue;

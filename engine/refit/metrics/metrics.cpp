@@ -54,15 +54,6 @@ std::size_t count_face_centres_inside(const Garment& g, const Points& positions,
 }
 
 
-Vec3 face_normal(const Points& positions, std::span<const Index> face) {
-  Vec3 n = Vec3::Zero();
-  for (std::size_t k = 0; k < face.size(); ++k) {
-    const Vec3 a = row3(positions, face[k]), b = row3(positions, face[(k + 1) % face.size()]);
-    n += a.cross(b);
-  }
-  return n;
-}
-
 double profile_straightness(const Points& curve, const Points& original, bool closed) {
   if (curve.rows() != original.rows())
     throw Error("profile straightness: the curve has " + std::to_string(curve.rows()) + " points, its original " +

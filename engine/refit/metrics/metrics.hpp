@@ -121,9 +121,6 @@ CurveScores score_curve(const Points& curve, const Points& original, bool closed
 std::vector<FeatureCurveInput> feature_curve_inputs(const Garment& original, const Points& result, const BodyMesh& a,
                                                     const BodyMesh& b, const std::vector<FeatureSpec>& specs);
 
-/// Newell normal of face f (not normalised; zero for a degenerate face).
-Vec3 face_normal(const Points& positions, std::span<const Index> face);
-
 /// Faces (3 corners or more) whose centre (corner mean) is inside `body`. Parallel.
 std::size_t count_face_centres_inside(const Garment& g, const Points& positions, const BodySurface& body);
 

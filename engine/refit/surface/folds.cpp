@@ -15,16 +15,6 @@ constexpr std::size_t kGrain = 4096;
 // the other way is no fold.
 constexpr double kSmoothAround = 0.5;
 
-// Newell normal of face f (twice its area, for a planar face); zero for points and lines.
-Vec3 face_normal(const Garment& g, const Points& positions, std::size_t f) {
-  const auto face = g.faces.row(f);
-  Vec3 n = Vec3::Zero();
-  if (face.size() < 3) return n;
-  for (std::size_t i = 0; i < face.size(); ++i)
-    n += row3(positions, face[i]).cross(row3(positions, face[(i + 1) % face.size()]));
-  return n;
-}
-
 // Face normals and, per vertex, the sum of its faces' normals (in face order: the same bits for any thread count).
 struct Orientation {
   const Garment& g;
@@ -34,7 +24,7 @@ struct Orientation {
   Orientation(const Garment& garment, const Csr& fov, const Points& positions)
       : g(garment), faces_of_vertex(fov), face(garment.faces.rows()), vertex(positions.rows()) {
     parallel_for(0, face.size(), kGrain, [&](std::size_t b, std::size_t e) {
-      for (std::size_t f = b; f < e; ++f) face[f] = face_normal(g, positions, f);
+      for (std::size_t f = b; f < e; ++f) face[f] = face_normal(positions, g.faces.row(f));
     });
     parallel_for(0, vertex.size(), kGrain, [&](std::size_t b, std::size_t e) {
       for (std::size_t v = b; v < e; ++v) vertex[v] = sum_at(Index(v));
@@ -61,7 +51,7 @@ struct Orientation {
       for (Index f : faces_of_vertex.row(v))
         if (face_mark[f] != stamp - 1) face_mark[f] = stamp - 1, turned.push_back(f);
     parallel_for(0, turned.size(), 1024, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) face[turned[i]] = face_normal(g, positions, turned[i]);
+      for (std::size_t i = b; i < e; ++i) face[turned[i]] = face_normal(positions, g.faces.row(turned[i]));
     });
     for (Index f : turned)
       for (Index v : g.faces.row(f))
