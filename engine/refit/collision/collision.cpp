@@ -499,23 +499,50 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     std::sort(to_check.begin(), to_check.end());
     if (!to_check.empty()) correction_round(false, true);
   }
-  // Anything still inside after the last round (reported, never hidden). A
-  // vertex checked where it is now and found outside (outside_by > 0: zeroed
-  // whenever a vertex moves) needs no query, nor do the points of a face within
-  // such a corner's outside ball.
-  if (report.rounds > 0) {
-    const std::size_t t = touched.size();
-    report.inside_after = deterministic_sum<std::size_t>(0, t, 256, 0, [&](std::size_t k) {
-      const Vec3 p = row3(positions, touched[k]);
-      return outside_by[touched[k]] <= 0.0 && p.allFinite() && body_b.inside(p) ? 1 : 0;
+  // Anything still inside after the last round. A vertex checked where it is
+  // now and found outside (outside_by > 0: zeroed whenever a vertex moves) needs
+  // no query, nor do the points of a face within such a corner's outside ball;
+  // only faces with a moved corner can have changed.
+  const auto left_inside = [&] {
+    std::vector<std::uint8_t> in(n, 0);  // per vertex: inside, or a corner of a face inside
+    std::vector<std::uint8_t> face_in(g.faces.rows(), 0);
+    parallel_for(0, touched.size(), 256, [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) {
+        const Vec3 p = row3(positions, touched[k]);
+        in[touched[k]] = outside_by[touched[k]] <= 0.0 && p.allFinite() && body_b.inside(p);
+      }
     });
-  }
-  // Only faces with a moved corner can have changed.
-  report.faces_inside_after = deterministic_sum<std::size_t>(0, g.faces.rows(), kGrain, 0, [&](std::size_t f) {
-    const auto face = g.faces.row(f);
-    const bool moved = std::any_of(face.begin(), face.end(), [&](Index v) { return is_touched[v] != 0; });
-    return std::size_t{moved ? face_inside(g, positions, f, body_b, options.probe_radius, outside_by) : face_inside_before[f] != 0};
-  });
+    report.inside_after = std::size_t(std::count(in.begin(), in.end(), 1));
+    parallel_for(0, g.faces.rows(), kGrain, [&](std::size_t b, std::size_t e) {
+      for (std::size_t f = b; f < e; ++f) {
+        const auto face = g.faces.row(f);
+        const bool moved = std::any_of(face.begin(), face.end(), [&](Index v) { return is_touched[v] != 0; });
+        face_in[f] = moved ? face_inside(g, positions, f, body_b, options.probe_radius, outside_by) : face_inside_before[f];
+      }
+    });
+    report.faces_inside_after = std::size_t(std::count(face_in.begin(), face_in.end(), 1));
+    for (std::size_t f = 0; f < face_in.size(); ++f)
+      if (face_in[f])
+        for (Index v : g.faces.row(f)) in[v] = 2;
+    std::vector<Index> left;
+    for (std::size_t i = 0; i < n; ++i)
+      if (in[i]) left.push_back(Index(i));
+    return left;
+  };
+  // A coarse face over the body's curve clears it geometrically, not at once
+  // (the dress's shoulder on a thin body asked its corners 0.5, 0.3, 0.13, 0.07
+  // cm in rounds 2 to 5 and was left 0.02 cm through): more rounds over what is
+  // still inside, at most options.inside_rounds, each over those vertices and
+  // faces' corners only.
+  if (report.rounds > 0)
+    for (int extra = 0;; ++extra) {
+      to_check = left_inside();
+      if (to_check.empty() || extra == options.inside_rounds) break;
+      report.inside_rounds = extra + 1;
+      correction_round(false, true);
+    }
+  else
+    left_inside();
   double total = 0.0;
   for (std::size_t k = 0; k < touched.size(); ++k) {
     const double d = (row3(positions, touched[k]) - first_position[k]).norm();
@@ -540,6 +567,7 @@ nlohmann::json CollisionReport::to_json() const {
           {"faces_inside_before", faces_inside_before},
           {"faces_inside_after", faces_inside_after},
           {"rounds", rounds},
+          {"inside_rounds", inside_rounds},
           {"rechecked", rechecked}};
 }
 

@@ -29,6 +29,7 @@ struct CollisionOptions {
   double repair_tilt = 0.02;
   int smoothing_passes = 12;    // Jacobi passes of the displacement field
   int max_rounds = 5;           // re-check and repeat while something is still too close
+  int inside_rounds = 10;       // then, at most this many more over what is still inside (vertices, faces' corners)
   double near_band = 1.0;       // garment units: vertices this close to body B (before the step) are lifted off it
   double max_lift = 0.1;        // by at most this beyond what they need (0 band: no limit)
   double face_clearance = 0.05; // garment units: what points inside faces keep from body B
@@ -66,6 +67,7 @@ struct CollisionReport {
   std::size_t faces_inside_before = 0;  // faces with an interior point inside the body (the body poking through)
   std::size_t faces_inside_after = 0;
   int rounds = 0;
+  int inside_rounds = 0;            // of them, rounds over what the others left inside
   std::size_t rechecked = 0;       // vertices checked again by the rounds after the first
 
   nlohmann::json to_json() const;

@@ -461,6 +461,9 @@ void GarmentBinding::collision_step(const BodySurface& surface_b, bool symmetric
   }
   if (c.inside_after > 0)
     result.warnings.push_back(std::to_string(c.inside_after) + " vertices are still inside body B after collision resolution");
+  if (c.faces_inside_after > 0)
+    result.warnings.push_back(std::to_string(c.faces_inside_after) +
+                              " faces still have the body poking through them after collision resolution");
 }
 
 void GarmentBinding::metrics_step(const BodySurface& surface_b, ResizeResult& result, const Progress& progress) const {
