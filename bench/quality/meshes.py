@@ -301,6 +301,46 @@ def face_samples(positions, faces, m=5):
     return pts, np.repeat(owner, len(bary))
 
 
+def face_probes(positions, faces, body_vertices):
+    """The points of every face right over the body's vertices near it: per fan
+    triangle, each body vertex within its reach whose projection onto the
+    triangle's plane falls inside the triangle, and that projection. Where a
+    body vertex rises through a coarse face between its sample points (the top
+    of a bump: a face is highest over the body there), the projection lies
+    inside the body. Returns (points, owner face)."""
+    tris, owner = [], []
+    for fi, f in enumerate(faces):
+        for k in range(1, len(f) - 1):
+            tris.append((f[0], f[k], f[k + 1]))
+            owner.append(fi)
+    if not tris:
+        return np.zeros((0, 3)), np.zeros(0, dtype=np.int64)
+    t = positions[np.asarray(tris)]
+    owner = np.asarray(owner)
+    centre = t.mean(axis=1)
+    reach = np.linalg.norm(t - centre[:, None, :], axis=2).max(axis=1) + 1.0
+    tree = cKDTree(body_vertices)
+    dot = lambda x, y: np.einsum("ij,ij->i", x, y)
+    pts, own = [], []
+    for s in range(0, len(t), 50000):  # bounded memory on dense garments
+        near = tree.query_ball_point(centre[s:s + 50000], reach[s:s + 50000])
+        count = np.fromiter((len(n) for n in near), dtype=np.int64, count=len(near))
+        tri = s + np.repeat(np.arange(len(near)), count)
+        vert = np.fromiter((i for n in near for i in n), dtype=np.int64, count=int(count.sum()))
+        a, ab, ac = t[tri, 0], t[tri, 1] - t[tri, 0], t[tri, 2] - t[tri, 0]
+        av = body_vertices[vert] - a
+        d00, d01, d11 = dot(ab, ab), dot(ab, ac), dot(ac, ac)
+        det = d00 * d11 - d01 * d01
+        ok = det > 1e-12 * d00 * d11
+        det = np.where(ok, det, 1.0)
+        u = (d11 * dot(av, ab) - d01 * dot(av, ac)) / det
+        v = (d00 * dot(av, ac) - d01 * dot(av, ab)) / det
+        keep = ok & (u >= 0) & (v >= 0) & (u + v <= 1)
+        pts.append(a[keep] + u[keep, None] * ab[keep] + v[keep, None] * ac[keep])
+        own.append(owner[tri[keep]])
+    return np.concatenate(pts), np.concatenate(own)
+
+
 def mirror_partners(positions, centre_x=0.0, tol=0.3):
     """For each vertex, the vertex at its mirror image about x = centre_x (or -1)."""
     tree = cKDTree(positions)

@@ -88,7 +88,8 @@ TARGET_TEXT = {
     "hem_level": "hem height spread <= the warp's",
 }
 # Face interiors since the collision step probes a coarse face's points over body B's
-# vertices (2026-11-27): 0 in all 22 cases, scored at 21 points per fan triangle.
+# vertices (2026-11-27): 0 in all 22 cases, scored at 21 points per fan triangle; and
+# with the points over body B's vertices too since the rounds over what is left inside.
 ASSERTED = ["flipped", "inside_vertices", "inside_faces"]
 # A face of the input this far inside body A (cm) marks its corners: see input_sunk.
 INPUT_SUNK_CM = 0.1
@@ -202,7 +203,9 @@ def score(case, original, faces, ids, body_a, body_b, dist_a, sunk_a, result, wa
     dist_b = body_b.signed_distance(result)
     s["inside_vertices"] = int((dist_b < 0).sum())
     pts, owner = meshes.face_samples(result, faces)
-    s["inside_faces"] = int(len(np.unique(owner[body_b.signed_distance(pts) < 0])))
+    probes, probe_owner = meshes.face_probes(result, faces, body_b.vertices)
+    inside = np.concatenate([owner[body_b.signed_distance(pts) < 0], probe_owner[body_b.signed_distance(probes) < 0]])
+    s["inside_faces"] = int(len(np.unique(inside)))
     near = (dist_a >= 0) & (dist_a <= 1.0)
     s["near_body_change"] = float(np.abs(dist_b[near] - dist_a[near]).max()) if near.any() else 0.0
     # The same without the vertices of faces the input already sinks into body A:
