@@ -37,6 +37,7 @@ struct ResizeArgs {
   SurfaceOptions surface;
   double clearance = 0.2;
   double follow_body = 0.0;
+  double level_tolerance = ShapeMatchingOptions{}.level_tolerance_deg;
   PatternsOptions patterns;  // --patterns-out: the 2D patterns of each result (docs/patterns.md)
 };
 
@@ -213,6 +214,7 @@ int run(ResizeArgs a) {
   options.surface = a.surface;
   options.shape_matching.sampling_invariant = !(a.paper_closeness || paper);
   options.shape_matching.joint = !(a.ordered_features || paper);
+  options.shape_matching.level_tolerance_deg = paper ? 0.0 : a.level_tolerance;
   options.surface.encode_on_warped = a.encode_on_warped || paper;
   if (a.plain_sweeps || paper) options.surface.multigrid = false;
   if (a.v_cycles) options.surface.krylov = false;
@@ -454,6 +456,12 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
                  "Feature curve samples that sat within this of body A (cm, e.g. 1) keep their distance to body B, "
                  "so a fitted part follows the body; 0: the curves keep their shape there too (docs/method.md)")
       ->check(check_clearance)
+      ->capture_default_str()
+      ->group(kAdvanced);
+  app.add_option("--level-tolerance", a->level_tolerance,
+                 "A feature curve whose plane lies within this many degrees of level on body A (a hem, a waistline) "
+                 "stays level on body B instead of taking the warp's tilt; 0: off (docs/method.md)")
+      ->check(CLI::Range(0.0, 45.0))
       ->capture_default_str()
       ->group(kAdvanced);
   app.add_flag("--metrics", a->metrics, "Add fit, penetration and surface metrics of the warp and the result to the report");

@@ -6,6 +6,7 @@
 #include <refit/features/bspline.hpp>
 #include <refit/features/curve_metrics.hpp>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
@@ -426,9 +427,35 @@ void measure_curve_result(CurveResult& r, bool closed) {
   r.scale_result = similarity_scale(r.original, r.optimised);
 }
 
+Vec3 long_axis(const Points& v) {
+  if (v.rows() < 2) return Vec3::Zero();
+  const Eigen::RowVector3d mean = v.colwise().mean();
+  const Eigen::Matrix3d cov = (v.rowwise() - mean).transpose() * (v.rowwise() - mean);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  Vec3 axis = eig.eigenvectors().col(2);  // eigenvalues ascending
+  const Eigen::Index k = [&] {
+    Eigen::Index i;
+    axis.cwiseAbs().maxCoeff(&i);
+    return i;
+  }();
+  return axis(k) < 0.0 ? Vec3(-axis) : axis;
+}
+
+std::vector<std::uint8_t> level_curves(const std::vector<FeatureCurve>& curves, const Vec3& axis, double tolerance_deg) {
+  std::vector<std::uint8_t> level(curves.size(), 0);
+  if (!(tolerance_deg > 0.0) || axis.squaredNorm() == 0.0) return level;
+  const double cos_min = std::cos(tolerance_deg * M_PI / 180.0);
+  for (std::size_t k = 0; k < curves.size(); ++k) level[k] = std::abs(curves[k].plane.normal.dot(axis)) >= cos_min;
+  return level;
+}
+
 FeatureBinding bind_features(const ReferenceBody& a, std::vector<FeatureCurve> curves, const ShapeMatchingOptions& options) {
   FeatureBinding b;
   b.model = prepare_shape_model(std::move(curves), options);
+  if (options.joint && options.level_tolerance_deg > 0.0) {
+    b.model.long_axis = long_axis(a.mesh().vertices);
+    b.model.level = level_curves(b.model.curves, b.model.long_axis, options.level_tolerance_deg);
+  }
   for (const FeatureCurve& c : b.model.curves) {
     b.samples.push_back(a.bind(c.samples));
     b.aux.push_back(a.bind(c.aux));

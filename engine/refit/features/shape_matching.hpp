@@ -85,6 +85,10 @@ struct ShapeMatchingOptions {
   /// body A it follows body B.
   double follow_body = 0.0;
   double follow_tolerance = 0.0;  // garment units
+  /// Joint solve: a curve whose plane lies within this many degrees of level on
+  /// body A (its normal along body A's long axis: a hem, a waistline) keeps its
+  /// plane level on body B instead of taking the warp's tilt; 0: off.
+  double level_tolerance_deg = 2.0;
 };
 
 /// The weight actually applied to the raw sum of eq. 8 for a curve of m samples
@@ -114,7 +118,17 @@ struct ShapeModel {
   std::vector<CurveShape> shapes;
   std::vector<std::vector<Crossing>> crossings;  // per curve, with earlier curves only
   ShapeMatchingOptions options;
+  /// Per curve: its plane is level (see ShapeMatchingOptions::level_tolerance_deg),
+  /// and the body's long axis it is level against (bind_features sets them; empty: none).
+  std::vector<std::uint8_t> level;
+  Vec3 long_axis = Vec3::Zero();
 };
+
+/// The unit direction of a body's greatest extent (the principal axis of its
+/// vertices with the largest variance; its sign: towards the larger coordinate).
+Vec3 long_axis(const Points& body_vertices);
+/// Per curve: whether its plane's normal lies within `tolerance_deg` of `axis`.
+std::vector<std::uint8_t> level_curves(const std::vector<FeatureCurve>& curves, const Vec3& axis, double tolerance_deg);
 
 /// Coefficients of eqs. 5-6 on the original curve (2D coordinates in c.plane).
 CurveShape shape_coefficients(const FeatureCurve& c);
@@ -140,6 +154,7 @@ struct CurveResult {
   std::vector<FixedSample> crossings;  // samples on an earlier curve (in order: fixed where it put them; joint: shared)
   std::vector<FixedSample> cleared;    // joint: samples held at the clearance from body B (distance: how far they moved)
   std::vector<FixedSample> followed;   // joint: samples pulled back towards body B (distance: how far they moved)
+  bool level = false;                  // joint: its plane kept level (ShapeModel::level)
   double energy_warped = 0.0, energy_result = 0.0;  // eq. 9 (weights as applied) at the projected warped samples and at the result
   double shape_error_warped = 0.0, shape_error_result = 0.0;  // see curve_metrics.hpp
   double turning_angle_change_warped_deg = 0.0, turning_angle_change_result_deg = 0.0;

@@ -109,6 +109,7 @@ nlohmann::json features_report(const FeatureResult& curves) {
                     {"crossings", crossings},
                     {"cleared", cleared},
                     {"followed", followed},
+                    {"level", c.level},
                     {"scale_warped", c.scale_warped},
                     {"scale_result", c.scale_result},
                     {"shape_error_warped", c.shape_error_warped},
