@@ -50,6 +50,10 @@ struct CollisionOptions {
   /// the rounds then run again over those vertices, so what it leaves too close
   /// is pushed out by what it still needs.
   std::function<std::vector<std::pair<Index, Vec3>>(const Points& positions)> after_rounds;
+  /// The hook and the round after it, at most this many times (while the hook
+  /// moves something): the pipeline's symmetric pushes leave a pair apart by
+  /// what that round pushes out on one side only, and a second pass halves it.
+  int after_rounds_passes = 1;
   /// Optional: the garment's vertex_adjacency (core/topology.hpp), for a caller
   /// that resolves one garment on many bodies (on a 1M garment it takes 0.1 s
   /// to make); null: made here.
