@@ -216,7 +216,7 @@ TEST(JointMatching, ALevelHemStaysLevelWhereTheWarpTiltsIt) {
   for (const bool keep_level : {false, true}) {
     SCOPED_TRACE(keep_level ? "level kept" : "tilted");
     ShapeModel model = prepare_shape_model(curves);
-    if (keep_level) model.level = level, model.long_axis = axis;
+    if (keep_level) model.level = level;
     // Body B a column of radius 10 about the y axis: each profile is held at its waist.
     const FeatureResult r = match_shapes(model, ws, wa, [](const Vec3& p) { return std::hypot(p.x(), p.z()) - 10.0; });
     const CurveResult& hem = r.curves[0];

@@ -68,16 +68,18 @@ struct CurveFrame {
   }
 };
 
-// `level_axis` (or zero): the curve was level on body A, so its new plane keeps
-// its original normal (bodies A and B stand alike), whatever tilt the warp gave
-// it: a hem hangs level on any body, and the warp tilts it with body B's
-// front-to-back change (the shared dress's hem 1.7 cm out of level on F_thinner).
-CurveFrame curve_frame(const FeatureCurve& c, const Points& ws, const Points& wa, const Vec3& level_axis) {
+bool is_level(const ShapeModel& model, std::size_t k) { return k < model.level.size() && model.level[k]; }
+
+// `level`: the curve was level on body A, so its new plane keeps its original
+// normal (bodies A and B stand alike), whatever tilt the warp gave it: a hem
+// hangs level on any body, and the warp tilts it with body B's front-to-back
+// change (the shared dress's hem 1.7 cm out of level on F_thinner).
+CurveFrame curve_frame(const FeatureCurve& c, const Points& ws, const Points& wa, bool level) {
   CurveFrame f;
   const std::size_t m = c.size();
   f.plane = warped_feature_plane(c, ws, wa);
-  if (level_axis.squaredNorm() > 0.0) {
-    const Vec3 n = f.plane.normal.dot(level_axis) < 0.0 ? Vec3(-level_axis) : level_axis;
+  if (level) {
+    const Vec3 n = f.plane.normal.dot(c.plane.normal) < 0.0 ? Vec3(-c.plane.normal) : c.plane.normal;
     Vec3 u = f.plane.axis_u - f.plane.axis_u.dot(n) * n;
     if (!(u.norm() > 1e-9)) u = f.plane.axis_v - f.plane.axis_v.dot(n) * n;
     f.plane.normal = n;
@@ -304,11 +306,8 @@ FeatureResult match_shapes_jointly(const ShapeModel& model, const std::vector<Po
   };
   std::vector<CurveFrame> frame;
   frame.reserve(count);
-  for (std::size_t k = 0; k < count; ++k) {
-    const bool level = k < model.level.size() && model.level[k];
-    frame.push_back(curve_frame(model.curves[k], warped_samples[k], warped_aux[k],
-                                level ? model.curves[k].plane.normal : Vec3::Zero()));
-  }
+  for (std::size_t k = 0; k < count; ++k)
+    frame.push_back(curve_frame(model.curves[k], warped_samples[k], warped_aux[k], is_level(model, k)));
 
   // Slots: every sample that is not a crossing. Crossings: the earlier curve's
   // point, plus their original offset from it carried with that curve's frame.
@@ -421,7 +420,7 @@ FeatureResult match_shapes_jointly(const ShapeModel& model, const std::vector<Po
       // which the warp tilted. (Its plane term weighing 10x or 100x more kept it
       // more level against the profiles meeting it, but on the quality suite the
       // profiles then paid: written gaps over 0.05 cm in 3-4 cases instead of 2.)
-      const bool level = k < model.level.size() && model.level[k];
+      const bool level = is_level(model, k);
       const double w_plane = std::sqrt(o.plane_weight / (f.m * len2));
       const Row3 pu = f.plane.axis_u.transpose(), pv = f.plane.axis_v.transpose(), pn = f.plane.normal.transpose();
       auto X = [&](std::size_t i) { return &expr[k][i]; };
@@ -502,7 +501,7 @@ FeatureResult match_shapes_jointly(const ShapeModel& model, const std::vector<Po
     CurveResult& r = result.curves[k];
     r.plane = frame[k].plane;
     r.plane.point += sys.offset(k) * r.plane.normal;
-    r.level = k < model.level.size() && model.level[k];
+    r.level = is_level(model, k);
     r.optimised.resize(Eigen::Index(m), 3);
     for (std::size_t i = 0; i < m; ++i) r.optimised.row(Eigen::Index(i)) = sys.eval(expr[k][i]).transpose();
     // The curve's own samples (not crossings) that a step moved, and how far.

@@ -452,10 +452,8 @@ std::vector<std::uint8_t> level_curves(const std::vector<FeatureCurve>& curves, 
 FeatureBinding bind_features(const ReferenceBody& a, std::vector<FeatureCurve> curves, const ShapeMatchingOptions& options) {
   FeatureBinding b;
   b.model = prepare_shape_model(std::move(curves), options);
-  if (options.joint && options.level_tolerance_deg > 0.0) {
-    b.model.long_axis = long_axis(a.mesh().vertices);
-    b.model.level = level_curves(b.model.curves, b.model.long_axis, options.level_tolerance_deg);
-  }
+  if (options.joint && options.level_tolerance_deg > 0.0)
+    b.model.level = level_curves(b.model.curves, long_axis(a.mesh().vertices), options.level_tolerance_deg);
   for (const FeatureCurve& c : b.model.curves) {
     b.samples.push_back(a.bind(c.samples));
     b.aux.push_back(a.bind(c.aux));

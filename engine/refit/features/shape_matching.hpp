@@ -118,10 +118,9 @@ struct ShapeModel {
   std::vector<CurveShape> shapes;
   std::vector<std::vector<Crossing>> crossings;  // per curve, with earlier curves only
   ShapeMatchingOptions options;
-  /// Per curve: its plane is level (see ShapeMatchingOptions::level_tolerance_deg),
-  /// and the body's long axis it is level against (bind_features sets them; empty: none).
+  /// Per curve: its plane is level against body A's long axis (see
+  /// ShapeMatchingOptions::level_tolerance_deg; bind_features sets it; empty: none).
   std::vector<std::uint8_t> level;
-  Vec3 long_axis = Vec3::Zero();
 };
 
 /// The unit direction of a body's greatest extent (the principal axis of its
