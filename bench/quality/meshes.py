@@ -27,9 +27,13 @@ def read_positions(path):
         return np.asarray([l.split()[1:4] for l in f if l.startswith("v ")], dtype=float)
 
 
-def fan_triangles(faces):
+def fan_triangles(faces, with_owner=False):
+    """The faces' fan triangles (f0, fk, fk+1); with_owner: and each one's face."""
     tris = [(f[0], f[k], f[k + 1]) for f in faces for k in range(1, len(f) - 1)]
-    return np.asarray(tris, dtype=np.int64).reshape(-1, 3)
+    tris = np.asarray(tris, dtype=np.int64).reshape(-1, 3)
+    if not with_owner:
+        return tris
+    return tris, np.repeat(np.arange(len(faces)), [max(len(f) - 2, 0) for f in faces])
 
 
 def _closest_on_triangles(p, a, b, c):
@@ -286,14 +290,7 @@ def face_samples(positions, faces, m=5):
     (21 points for m = 5). Four points per triangle (the centroid and three near the
     corners' middles) missed the body poking through coarse faces between them by up
     to 0.07 cm on the shared garments."""
-    tris = []
-    owner = []
-    for fi, f in enumerate(faces):
-        for k in range(1, len(f) - 1):
-            tris.append((f[0], f[k], f[k + 1]))
-            owner.append(fi)
-    tris = np.asarray(tris)
-    owner = np.asarray(owner)
+    tris, owner = fan_triangles(faces, with_owner=True)
     n = m + 1
     bary = np.array([(1.0 - (i + 1 / 3) / n - (j + 1 / 3) / n, (i + 1 / 3) / n, (j + 1 / 3) / n)
                      for i in range(n) for j in range(n - i)])
@@ -308,15 +305,10 @@ def face_probes(positions, faces, body_vertices):
     body vertex rises through a coarse face between its sample points (the top
     of a bump: a face is highest over the body there), the projection lies
     inside the body. Returns (points, owner face)."""
-    tris, owner = [], []
-    for fi, f in enumerate(faces):
-        for k in range(1, len(f) - 1):
-            tris.append((f[0], f[k], f[k + 1]))
-            owner.append(fi)
-    if not tris:
+    tris, owner = fan_triangles(faces, with_owner=True)
+    if not len(tris):
         return np.zeros((0, 3)), np.zeros(0, dtype=np.int64)
-    t = positions[np.asarray(tris)]
-    owner = np.asarray(owner)
+    t = positions[tris]
     centre = t.mean(axis=1)
     reach = np.linalg.norm(t - centre[:, None, :], axis=2).max(axis=1) + 1.0
     tree = cKDTree(body_vertices)
