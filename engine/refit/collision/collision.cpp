@@ -5,6 +5,8 @@
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
 
+#include <tbb/parallel_sort.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -23,6 +25,50 @@ struct Constraint {
   bool active = false;
   bool inside = false;
 };
+
+using Found = std::vector<std::vector<std::pair<Index, Constraint>>>;
+
+// One constraint per constrained vertex, ascending: the vertex's own (from
+// `own`, blocks in ascending vertex order, a vertex at most once) first, then
+// its faces' in face order, the largest amount kept (the first of equal ones,
+// with the first's `inside`). The faces' entries are sorted by (vertex, order)
+// keys, in parallel: a stable sort of the million pairs of a dense garment's
+// first round took a tenth of a second.
+void merge_constraints(const Found& own, const Found& faces, std::vector<Index>& active, std::vector<Constraint>& con) {
+  std::vector<std::size_t> start(faces.size() + 1, 0);
+  for (std::size_t b = 0; b < faces.size(); ++b) start[b + 1] = start[b] + faces[b].size();
+  std::vector<const std::pair<Index, Constraint>*> entry(start.back());
+  UninitVector<std::uint64_t> key(start.back());
+  parallel_for(0, faces.size(), 1, [&](std::size_t bb, std::size_t be) {
+    for (std::size_t b = bb; b < be; ++b)
+      for (std::size_t k = 0; k < faces[b].size(); ++k) {
+        entry[start[b] + k] = &faces[b][k];
+        key[start[b] + k] = (std::uint64_t(faces[b][k].first) << 32) | std::uint64_t(start[b] + k);
+      }
+  });
+  tbb::parallel_sort(key.begin(), key.end());
+  const auto take = [&](Index i, const Constraint& c) {
+    if (!active.empty() && active.back() == i) {
+      if (c.amount > con.back().amount) con.back() = Constraint{c.dir, c.amount, true, con.back().inside};
+      return;
+    }
+    active.push_back(i);
+    con.push_back(c);
+  };
+  std::size_t f = 0;
+  const auto faces_up_to = [&](Index last) {  // the faces' entries of vertices up to `last`
+    for (; f < key.size() && Index(key[f] >> 32) <= last; ++f) {
+      const auto& [i, c] = *entry[key[f] & 0xffffffffu];
+      take(i, c);
+    }
+  };
+  for (const auto& list : own)
+    for (const auto& [i, c] : list) {
+      if (i > 0) faces_up_to(i - 1);
+      take(i, c);
+    }
+  faces_up_to(std::numeric_limits<Index>::max());
+}
 
 // The constraint of p, given whether it is inside body B and its closest point
 // (searched at least as far as the clearance).
@@ -331,22 +377,11 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     });
     for (const auto& list : found)
       for (const auto& ic : list) constrained[ic.first] = 0;
-    std::vector<std::pair<Index, Constraint>> by_vertex;
-    for (const auto& list : found) by_vertex.insert(by_vertex.end(), list.begin(), list.end());
-    const std::size_t vertex_constraints = by_vertex.size();
-    for (const auto& list : face_found) by_vertex.insert(by_vertex.end(), list.begin(), list.end());
-    // By vertex, in a fixed order (the vertex's own first, then faces in order), largest amount kept.
-    std::stable_sort(by_vertex.begin(), by_vertex.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    std::size_t vertex_constraints = 0;
+    for (const auto& list : found) vertex_constraints += list.size();
     std::vector<Index> active;  // ascending
     std::vector<Constraint> con;  // aligned with `active`
-    for (const auto& [i, c] : by_vertex) {
-      if (!active.empty() && active.back() == i) {
-        if (c.amount > con.back().amount) con.back() = Constraint{c.dir, c.amount, true, con.back().inside};
-        continue;
-      }
-      active.push_back(i);
-      con.push_back(c);
-    }
+    merge_constraints(found, face_found, active, con);
     if (all) {
       report.too_close = vertex_constraints;
       for (const auto& list : found)
