@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -115,6 +116,31 @@ TEST(Folds, PinnedVerticesKeepTheirPlace) {
   EXPECT_TRUE(row3(p, kCentre) == centre);
   EXPECT_LE(folds_against(grid.g, p, grid.map), folded);
   EXPECT_LE(r.folded_after, r.folded_before);
+}
+
+// Without the smoothing's rounds, the reshaping alone: each face leaning more
+// than 60 degrees off its corners takes its original shape turned as its
+// neighbourhood turned, which unfolds the crumple and moves only the faces
+// around it; with neither, nothing moves.
+TEST(Folds, FacesLeftTurnedTakeTheirOriginalShapeTurnedAsAround) {
+  const Grid grid;
+  Points p = crumpled(grid.g, grid.map);
+  const Points before = p;
+  ASSERT_GE(folds_against(grid.g, p, grid.map), 2u);
+  FoldOptions none;
+  none.max_rounds = 0;
+  none.reshape_rounds = 0;
+  EXPECT_EQ(smooth_out_folds(grid.g, grid.binding, p, grid.adjacency, nullptr, none).smoothed, 0u);
+  EXPECT_TRUE(p == before);
+  FoldOptions reshape_only;
+  reshape_only.max_rounds = 0;
+  const FoldReport r = smooth_out_folds(grid.g, grid.binding, p, grid.adjacency, nullptr, reshape_only);
+  EXPECT_EQ(folds_against(grid.g, p, grid.map), 0u);
+  EXPECT_EQ(r.folded_after, 0u);
+  EXPECT_GT(r.smoothed, 0u);
+  const auto ring = grid.adjacency.row(kCentre);
+  for (Index v = 0; v < p.rows(); ++v)  // only the centre and its neighbours moved
+    if (p.row(v) != before.row(v)) EXPECT_TRUE(v == kCentre || std::find(ring.begin(), ring.end(), v) != ring.end()) << v;
 }
 
 TEST(Folds, NothingChangesWhenSmoothingCannotHelp) {

@@ -17,13 +17,14 @@ struct FoldOptions {
   int rings = 2;       // the smoothed region: the folded faces' corners and this many rings around them
   int passes = 10;     // Jacobi passes of the smoothing per round
   int max_rounds = 5;  // re-detect and smooth again (the region grown by `rings`) while folds are left
+  int reshape_rounds = 5;  // then faces leaning over 60 degrees take their original shape, turned as around (folds.cpp)
 };
 
 struct FoldReport {
   std::size_t folded_before = 0;  // faces folded when the smoothing starts
   std::size_t folded_after = 0;   // ... and when it ends
-  std::size_t smoothed = 0;       // vertices moved
-  int rounds = 0;
+  std::size_t smoothed = 0;       // vertices moved (smoothed or reshaped)
+  int rounds = 0;                 // smoothing rounds run
 };
 
 /// What the fold smoothing needs of a garment, made once for any number of bodies.
@@ -46,7 +47,11 @@ FoldBinding bind_folds(const Garment& g);
 /// displacement from the original (Jacobi passes, the region's edge held: a
 /// smooth stretch or turn is kept, a crumple is not), pinned vertices excepted
 /// (per vertex, or null). A round that leaves no fewer folds is undone and ends
-/// the smoothing (the detector misreads some small details). `adjacency`:
+/// the smoothing (the detector misreads some small details). Then the faces
+/// still leaning more than 60 degrees off their corners (slivers of a split
+/// mesh, which smoothing cannot even out that finely) take their original shape
+/// turned as their neighbourhood turned (folds.cpp). Folds are counted with the
+/// slivers turned over against their neighbourhood. `adjacency`:
 /// vertex_adjacency(g). The same bits for any thread count.
 FoldReport smooth_out_folds(const Garment& g, const FoldBinding& binding, Points& positions, const Csr& adjacency,
                             const std::vector<std::uint8_t>* pinned, const FoldOptions& options = {});
