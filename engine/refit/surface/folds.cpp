@@ -3,7 +3,7 @@
 #include <refit/core/parallel.hpp>
 #include <refit/core/topology.hpp>
 
-#include <Eigen/SVD>
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <unordered_map>
@@ -74,37 +74,30 @@ struct Orientation {
   bool retested(Index f) const { return !face_mark.empty() && face_mark[f] == stamp; }
 };
 
-// The best similarity (rotation, scale) carrying a face's neighbourhood (the
-// corners of the faces around its corners) from the original to `positions`.
+// How a face's neighbourhood (the corners of the faces around its corners)
+// turned and grew from the original to `positions`: its best rotation
+// (Eigen::umeyama) and the ratio of its spreads about its centre.
 struct Similarity {
   Eigen::Matrix3d rotation;
   double scale;
 };
 Similarity hood_similarity(const Garment& g, const Csr& faces_of_vertex, const Points& positions,
                            std::span<const Index> face) {
-  const Points& original = g.positions;
   std::vector<Index> hood;
   for (Index v : face)
     for (Index f : faces_of_vertex.row(v))
       for (Index w : g.faces.row(f)) hood.push_back(w);
   std::sort(hood.begin(), hood.end());
   hood.erase(std::unique(hood.begin(), hood.end()), hood.end());
-  Vec3 c0 = Vec3::Zero(), c1 = Vec3::Zero();
-  for (Index w : hood) c0 += row3(original, w), c1 += row3(positions, w);
-  c0 /= double(hood.size());
-  c1 /= double(hood.size());
-  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-  double s0 = 0.0, s1 = 0.0;
-  for (Index w : hood) {
-    const Vec3 x = row3(original, w) - c0, y = row3(positions, w) - c1;
-    h += x * y.transpose();
-    s0 += x.squaredNorm();
-    s1 += y.squaredNorm();
+  Eigen::Matrix3Xd from(3, hood.size()), to(3, hood.size());
+  for (std::size_t i = 0; i < hood.size(); ++i) {
+    from.col(Eigen::Index(i)) = row3(g.positions, hood[i]);
+    to.col(Eigen::Index(i)) = row3(positions, hood[i]);
   }
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d u = svd.matrixU();
-  if ((svd.matrixV() * u.transpose()).determinant() < 0.0) u.col(2) = -u.col(2);
-  return {svd.matrixV() * u.transpose(), s0 > 0.0 ? std::sqrt(s1 / s0) : 1.0};
+  const Eigen::Matrix3d rotation = Eigen::umeyama(from, to, false).topLeftCorner<3, 3>();
+  const double s0 = (from.colwise() - from.rowwise().mean()).squaredNorm();
+  const double s1 = (to.colwise() - to.rowwise().mean()).squaredNorm();
+  return {rotation, s0 > 0.0 ? std::sqrt(s1 / s0) : 1.0};
 }
 
 // Whether face f points against its original normal turned as its
