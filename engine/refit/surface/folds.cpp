@@ -158,7 +158,7 @@ bool keep_if_fewer(Orientation& o, Points& positions, const std::vector<Index>& 
 // which the collision step's next round turns over (the 1M dress on F_thinner:
 // 1 fold left by the smoothing, 31 after the round). Each face that agreed on
 // the original and now leans that far takes its original shape, turned and
-// scaled by the best similarity of its neighbourhood from the original to now,
+// scaled as its neighbourhood was from the original to now (hood_similarity),
 // about its centre now; a corner of several takes the mean (in face order),
 // pinned corners stay. A round that leaves no fewer such faces is undone and
 // ends it. Returns the vertices moved.
