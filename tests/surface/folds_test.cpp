@@ -139,8 +139,11 @@ TEST(Folds, FacesLeftTurnedTakeTheirOriginalShapeTurnedAsAround) {
   EXPECT_EQ(r.folded_after, 0u);
   EXPECT_GT(r.smoothed, 0u);
   const auto ring = grid.adjacency.row(kCentre);
-  for (Index v = 0; v < p.rows(); ++v)  // only the centre and its neighbours moved
-    if (p.row(v) != before.row(v)) EXPECT_TRUE(v == kCentre || std::find(ring.begin(), ring.end(), v) != ring.end()) << v;
+  for (Index v = 0; v < p.rows(); ++v) {  // only the centre and its neighbours moved
+    if (p.row(v) != before.row(v)) {
+      EXPECT_TRUE(v == kCentre || std::find(ring.begin(), ring.end(), v) != ring.end()) << v;
+    }
+  }
 }
 
 TEST(Folds, NothingChangesWhenSmoothingCannotHelp) {
