@@ -61,7 +61,7 @@ struct Orientation {
     std::vector<Index> turned, corners;
     if (many) {
       for (Index v : moved) vertex_mark[v] = stamp - 1;
-      turned = marked_faces(stamp - 1, [&](Index f) {
+      turned = marked(face_mark, stamp - 1, [&](Index f) {
         const auto c = g.faces.row(f);
         return std::any_of(c.begin(), c.end(), [&](Index v) { return vertex_mark[v] == stamp - 1; });
       });
@@ -88,7 +88,7 @@ struct Orientation {
     });
     std::vector<Index> retest;
     if (many) {
-      retest = marked_faces(stamp, [&](Index f) {
+      retest = marked(face_mark, stamp, [&](Index f) {
         const auto c = g.faces.row(f);
         return std::any_of(c.begin(), c.end(), [&](Index v) { return vertex_mark[v] == stamp; });
       });
@@ -100,12 +100,8 @@ struct Orientation {
     }
     return retest;
   }
-  // Marks of the faces for which `hit` is true set to `mark`, in parallel (each
-  // face its own); returns them ascending.
-  template <class Hit>
-  std::vector<Index> marked_faces(std::uint32_t mark, const Hit& hit) {
-    return marked(face_mark, mark, hit);
-  }
+  // The marks (of faces or vertices) for which `hit` is true set to `mark`, in
+  // parallel (each its own); returns their indices ascending.
   template <class Hit>
   static std::vector<Index> marked(std::vector<std::uint32_t>& marks, std::uint32_t mark, const Hit& hit) {
     const std::size_t n = marks.size(), blocks = (n + kGrain - 1) / kGrain;
