@@ -309,6 +309,29 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     touched.push_back(i);
     first_position.push_back(row3(positions, i));
   };
+  // touch() for every vertex of a region (ascending), the list and the starts filled in parallel.
+  const auto touch_all = [&](const std::vector<Index>& region) {
+    std::vector<std::vector<Index>> fresh((region.size() + kGrain - 1) / kGrain);
+    parallel_for(0, fresh.size(), 1, [&](std::size_t b, std::size_t e) {
+      for (std::size_t blk = b; blk < e; ++blk)
+        for (std::size_t k = blk * kGrain; k < std::min(region.size(), (blk + 1) * kGrain); ++k)
+          if (!is_touched[region[k]]) fresh[blk].push_back(region[k]);
+    });
+    std::vector<std::size_t> at(fresh.size() + 1, touched.size());
+    for (std::size_t blk = 0; blk < fresh.size(); ++blk) at[blk + 1] = at[blk] + fresh[blk].size();
+    touched.resize(at.back());
+    first_position.resize(at.back());
+    parallel_for(0, fresh.size(), 1, [&](std::size_t b, std::size_t e) {
+      for (std::size_t blk = b; blk < e; ++blk)
+        for (std::size_t k = 0; k < fresh[blk].size(); ++k) {
+          const Index i = fresh[blk][k];
+          is_touched[i] = 1;
+          touched_slot[i] = Index(at[blk] + k);
+          touched[at[blk] + k] = i;
+          first_position[at[blk] + k] = row3(positions, i);
+        }
+    });
+  };
   // One round: `all`: check every vertex and face (else those of to_check);
   // `last_round`: faces with a constrained corner are asked now, not next time.
   // Returns false when nothing was too close.
@@ -396,32 +419,49 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     // the rings a vertex may still pass the correction on.
     std::vector<Index> region = active;
     const int max_rings = std::max(0, options.smoothing_rings);
+    std::vector<int> rings_of(active.size(), max_rings);
+    if (!all && options.repair_tilt > 0.0)
+      parallel_for(0, active.size(), 1024, [&](std::size_t b, std::size_t e) {
+        for (std::size_t a = b; a < e; ++a) {
+          const Index i = active[a];
+          if (adj.row_size(i) == 0) continue;
+          double edge = 0.0;
+          for (Index j : adj.row(i)) edge += (row3(positions, j) - row3(positions, i)).norm();
+          edge /= double(adj.row_size(i));
+          const double needed = con[a].amount / (options.repair_tilt * edge);
+          if (needed < max_rings) rings_of[a] = std::max(1, static_cast<int>(std::ceil(needed)));
+        }
+      });
     std::vector<std::vector<Index>> at_level(std::size_t(max_rings) + 1);
     for (std::size_t a = 0; a < active.size(); ++a) {
-      const Index i = active[a];
-      int rings = max_rings;
-      if (!all && options.repair_tilt > 0.0 && adj.row_size(i) > 0) {
-        double edge = 0.0;
-        for (Index j : adj.row(i)) edge += (row3(positions, j) - row3(positions, i)).norm();
-        edge /= double(adj.row_size(i));
-        const double needed = con[a].amount / (options.repair_tilt * edge);
-        if (needed < max_rings) rings = std::max(1, static_cast<int>(std::ceil(needed)));
-      }
-      ring[i] = rings;
-      at_level[std::size_t(rings)].push_back(i);
+      ring[active[a]] = rings_of[a];
+      at_level[std::size_t(rings_of[a])].push_back(active[a]);
     }
-    for (int level = max_rings; level > 0; --level)
-      for (Index v : at_level[std::size_t(level)]) {
-        if (ring[v] != level) continue;  // reached since from a larger correction
-        for (Index j : adj.row(v))
-          if (ring[j] < level - 1 && finite[j]) {
+    // Level by level: the neighbours a level may reach are listed in parallel
+    // (ring[] only read), then taken in list order (the order a serial walk
+    // takes them: the same rings and the same lists).
+    for (int level = max_rings; level > 0; --level) {
+      const std::vector<Index>& from = at_level[std::size_t(level)];
+      std::vector<std::vector<Index>> reach((from.size() + kGrain - 1) / kGrain);
+      parallel_for(0, reach.size(), 1, [&](std::size_t b, std::size_t e) {
+        for (std::size_t blk = b; blk < e; ++blk)
+          for (std::size_t k = blk * kGrain; k < std::min(from.size(), (blk + 1) * kGrain); ++k) {
+            const Index v = from[k];
+            if (ring[v] != level) continue;  // reached since from a larger correction
+            for (Index j : adj.row(v))
+              if (ring[j] < level - 1 && finite[j]) reach[blk].push_back(j);
+          }
+      });
+      for (const auto& list : reach)
+        for (Index j : list)
+          if (ring[j] < level - 1) {
             if (ring[j] < 0) region.push_back(j);
             ring[j] = level - 1;
             at_level[std::size_t(level - 1)].push_back(j);
           }
-      }
-    std::sort(region.begin(), region.end());  // mesh order: deterministic and cache-friendly
-    for (Index i : region) touch(i);
+    }
+    tbb::parallel_sort(region.begin(), region.end());  // mesh order: deterministic and cache-friendly
+    touch_all(region);
 
     // 3. Jacobi smoothing of the displacement field; constrained vertices keep
     // at least their required displacement along their direction. Vertices out of
