@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -394,6 +395,44 @@ TEST(SurfaceBindingTest, AutoVoxelLandsNearTheBudget) {
   EXPECT_GT(b.bind_stats().agents, 1500u);
   EXPECT_LT(b.bind_stats().agents, 4500u);
   EXPECT_GT(b.bind_stats().ring_degree_mean, 3.5);
+}
+
+// The snap's reach (feature_snap.hpp): every vertex within snap_radius voxels of
+// a feature sample is moved by that sample's agent, with weight (1 - d^2/r^2)^2,
+// whatever agents its blend picked; none farther, and none with radius 0.
+TEST(SurfaceSnapReach, EveryVertexWithinTheRadiusOfASampleAndNoOther) {
+  const Garment g = flat_patch(41, 0.25);  // 10 x 10 in the x-z plane
+  Points samples(5, 3);
+  for (int k = 0; k < 5; ++k) samples.row(k) << 3.0 + 1.0 * k, 0.0, 5.1;
+  SurfaceOptions o;
+  o.voxel = 0.5;
+  o.snap_radius = 2.0;  // 1.0 in garment units
+  const SurfaceBinding b = SurfaceBinding::bind(g, samples, o);
+  const SnapReach reach = b.snap_reach(g.positions, {});
+  ASSERT_EQ(reach.reach.rows(), g.vertex_count());
+  std::size_t reached = 0;
+  for (Index v = 0; v < Index(g.vertex_count()); ++v) {
+    const Vec3 p = row3(g.positions, v);
+    std::vector<int> want;
+    for (int k = 0; k < 5; ++k)
+      if ((p - row3(samples, k)).squaredNorm() < 1.0 - 1e-9) want.push_back(k);
+    std::vector<int> got;
+    const auto r = reach.reach.row(v);
+    for (std::size_t q = 0; q < r.size(); ++q) {
+      const int k = b.feature_of()[r[q]];
+      ASSERT_GE(k, 0) << "only feature agents move a vertex in the snap";
+      got.push_back(k);
+      const double d2 = (p - row3(samples, k)).squaredNorm();
+      EXPECT_NEAR(reach.weight[reach.reach.offsets[v] + q], std::pow(1.0 - d2, 2), 1e-6);
+    }
+    std::sort(got.begin(), got.end());
+    EXPECT_EQ(got, want) << "vertex " << v;
+    reached += !got.empty();
+  }
+  EXPECT_GT(reached, 100u);
+  o.snap_radius = 0.0;
+  const SurfaceBinding through_blends = SurfaceBinding::bind(g, samples, o);
+  EXPECT_TRUE(through_blends.snap_reach(g.positions, {}).reach.indices.empty());
 }
 
 }  // namespace

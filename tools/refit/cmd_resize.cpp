@@ -407,6 +407,12 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
       ->capture_default_str()
       ->check(CLI::Range(0, 16))
       ->group(kAdvanced);
+  app.add_option("--snap-radius", a->surface.snap_radius,
+                 "The snap through the features moves the vertices within this many voxels of each feature sample "
+                 "(0 = through the reconstruction's blend weights, which can miss a sample's own corners)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 16.0))
+      ->group(kAdvanced);
   app.add_option("--feature-bend", a->surface.feature_bend_radius,
                  "Within about this distance of a feature (cm) the surface is solved again so that it leaves the "
                  "feature with the feature's slope instead of a crease (0 = off: the paper's eq. 13 alone; docs/method.md)")

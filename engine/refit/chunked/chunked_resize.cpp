@@ -283,7 +283,7 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
       };
       RecordFile<SnapTerm> snap_terms(plan_.folder);
       std::size_t snap_count = 0;
-      bool any_weight = false;  // apply's blend weights are not empty
+      bool any_weight = false;  // the snap's weights are not empty
       const bool snaps = surface.snaps();
       surfaced.emplace(plan_.folder, nv);
       st.vertices_capped = st.vertices_without_agent = 0;
@@ -294,7 +294,6 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
         const VertexBlends blends = surface.vertex_blends(original, layer);
         st.vertices_capped += blends.capped;
         st.vertices_without_agent += blends.without_agent;
-        any_weight = any_weight || !blends.weight.empty();
         std::vector<std::uint8_t> carries;
         if (surface.options().feature_zone_rings > 0) {
           carries.assign(std::size_t(original.rows()), 0);
@@ -305,6 +304,13 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
         const Points s = surface.emit_vertices(sol, original, w, blends, carries, near, kept, st);
         surfaced->write(first, s);
         if (!snaps) return;
+        // The snap's reach: its own (snap_radius > 0) or the blends', as SurfaceBinding::snap takes it.
+        SnapReach own_reach;
+        if (surface.options().snap_radius > 0.0) own_reach = surface.snap_reach(original, layer);
+        const bool kernel = surface.options().snap_radius > 0.0;
+        const Csr& reach = kernel ? own_reach.reach : blends.reach;
+        const std::vector<float>& weight = kernel ? own_reach.weight : blends.weight;
+        any_weight = any_weight || !weight.empty();
         const auto held = [&](std::size_t i) { return !kept.empty() && kept[i]; };
         const auto lo = std::lower_bound(sample_vertices.begin(), sample_vertices.end(), Index(first));
         for (auto it = lo; it != sample_vertices.end() && *it < first + std::size_t(s.rows()); ++it) {
@@ -312,18 +318,17 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
           SnapVertex& v = snap_vertices[*it];
           v.position = row3(s, Index(i));
           v.held = held(i);
-          const auto r = blends.reach.row(i);
+          const auto r = reach.row(i);
           v.reach.assign(r.begin(), r.end());
-          if (!blends.weight.empty())
-            v.weight.assign(blends.weight.begin() + blends.reach.offsets[i], blends.weight.begin() + blends.reach.offsets[i + 1]);
+          if (!weight.empty()) v.weight.assign(weight.begin() + reach.offsets[i], weight.begin() + reach.offsets[i + 1]);
         }
         std::vector<SnapTerm> terms;
         for (std::size_t i = 0; i < std::size_t(s.rows()); ++i) {
-          if (held(i) || blends.weight.empty()) continue;
-          const auto r = blends.reach.row(i);
+          if (held(i) || weight.empty()) continue;
+          const auto r = reach.row(i);
           for (std::size_t q = 0; q < r.size(); ++q)
             if (surface.feature_of()[r[q]] >= 0)
-              terms.push_back({Index(first + i), surface.feature_of()[r[q]], blends.weight[blends.reach.offsets[i] + q]});
+              terms.push_back({Index(first + i), surface.feature_of()[r[q]], weight[reach.offsets[i] + q]});
         }
         snap_terms.write(snap_count, std::span<const SnapTerm>(terms));
         snap_count += terms.size();

@@ -38,6 +38,7 @@ void check_surface_options(const SurfaceOptions& o) {
     throw bad("multigrid over-correction must lie in (0, 2)");
   if (o.max_reach_agents == 0 || o.max_reach_agents > 255) throw bad("max reach agents must be 1 to 255");
   if (o.feature_zone_rings < 0 || o.feature_zone_rings > 16) throw bad("feature zone must be 0 to 16 one-ring steps");
+  if (!(o.snap_radius >= 0.0) || !std::isfinite(o.snap_radius)) throw bad("snap radius must be 0 or positive");
   if (!(o.snap_regularisation > 0.0) || !std::isfinite(o.snap_regularisation))
     throw bad("snap regularisation must be positive");
 }
@@ -144,6 +145,7 @@ SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, co
   SurfaceBinding s = bind_agents(std::move(part), features, options, std::move(attachment));
   clock.reset();
   s.blends_ = s.vertex_blends(g.positions, vertex_layer);
+  if (s.snaps()) s.snap_reach_ = s.snap_reach(g.positions, vertex_layer);
   s.stats_.vertices_capped = s.blends_.capped;
   s.stats_.vertices_without_agent = s.blends_.without_agent;
   if (options.feature_zone_rings > 0) {

@@ -6,12 +6,13 @@
 // a feature sample carried on the output's faces lands near, not on, its
 // optimised position. The paper's surface interpolates the feature agents; a
 // mesh only does when its vertices are corrected. The correction is carried by
-// the feature agents through the same smooth blend weights the reconstruction
-// used: vertex v moves by sum_a w(v, a) c_a over the feature agents a in its
-// reach, and the c solve one small least-squares problem (one row per feature
-// sample, Tikhonov-regularised) so the carried samples reach their targets.
-// The correction is smooth (it fades with the blend weights over the reach)
-// and zero where the reconstruction already hit the targets (A = B).
+// the feature agents: vertex v moves by sum_a w(v, a) c_a over the feature
+// agents a in its snap reach (SurfaceBinding::snap_reach: those within
+// SurfaceOptions::snap_radius voxels, w = (1 - d^2/r^2)^2; or, with radius 0,
+// the reconstruction's own blend reach and weights), and the c solve one small
+// least-squares problem (one row per feature sample, Tikhonov-regularised) so
+// the carried samples reach their targets. The correction is smooth (it fades
+// with w) and zero where the reconstruction already hit the targets (A = B).
 #include <refit/attach/attachment.hpp>
 #include <refit/core/types.hpp>
 
@@ -63,7 +64,7 @@ double snapped_gap(const FeatureSnap& snap, const Points& targets, const Surface
 
 /// Corrects `positions` (every garment vertex) so that the feature samples
 /// attached by `attachment` reach `targets`. `reach`/`reach_weight`: each
-/// vertex's agents and normalised blend weights; `feature_of`: per agent, its
+/// vertex's agents and their weights (the snap reach or the blends, above); `feature_of`: per agent, its
 /// feature sample or -1; `held`: vertices that must not move (empty: none).
 /// `regularisation`: Tikhonov weight relative to the mean diagonal of the
 /// normal equations. Deterministic for any thread count.

@@ -2,6 +2,7 @@
 // 14-15), the coarse-to-fine start, the solve of eq. 13 with the clearance
 // rounds, and the way back to vertices (reconstruct.cpp) and through the
 // optimised curves (feature_snap.cpp). Binding: bind.cpp; solvers: solver.cpp.
+#include <refit/body/centre_tree.hpp>
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
 #include <refit/core/progress.hpp>
@@ -208,6 +209,44 @@ SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
   return res;
 }
 
+SnapReach SurfaceBinding::snap_reach(const Points& positions, std::span<const std::uint32_t> layer) const {
+  SnapReach out;
+  const std::size_t nv = std::size_t(positions.rows()), nf = feature_slot_.size();
+  out.reach.offsets.assign(nv + 1, 0);
+  const double r2 = std::pow(options_.snap_radius * h_, 2);
+  if (nf == 0 || !(r2 > 0.0)) return out;
+  Points samples(Eigen::Index(nf), 3);
+  for (std::size_t k = 0; k < nf; ++k) samples.row(Eigen::Index(k)) = original_agents_.row(feature_slot_[k]);
+  const PointTree tree(samples);
+  // Fixed blocks, each with its own lists, joined in block order: the same for any thread count.
+  const std::size_t blocks = (nv + kGrain - 1) / kGrain;
+  std::vector<std::vector<Index>> slots(blocks);
+  std::vector<std::vector<float>> weights(blocks);
+  parallel_for(0, blocks, 1, [&](std::size_t b, std::size_t e) {
+    std::vector<std::pair<Index, double>> near;
+    for (std::size_t blk = b; blk < e; ++blk)
+      for (std::size_t v = blk * kGrain; v < std::min(nv, (blk + 1) * kGrain); ++v) {
+        // A vertex of a layer is moved by its own layer's feature agents only (as it blends its own layer's agents).
+        const std::uint32_t own = layer.empty() ? 0u : layer[v];
+        tree.within(row3(positions, Index(v)), r2, near);
+        for (const auto& [k, d2] : near) {
+          const Index slot = feature_slot_[k];
+          const double t = 1.0 - d2 / r2;
+          if ((own != 0 && layer_[slot] != own) || !(t > 0.0)) continue;
+          slots[blk].push_back(slot);
+          weights[blk].push_back(static_cast<float>(t * t));
+          ++out.reach.offsets[v + 1];
+        }
+      }
+  });
+  for (std::size_t v = 0; v < nv; ++v) out.reach.offsets[v + 1] += out.reach.offsets[v];
+  for (std::size_t blk = 0; blk < blocks; ++blk) {
+    out.reach.indices.insert(out.reach.indices.end(), slots[blk].begin(), slots[blk].end());
+    out.weight.insert(out.weight.end(), weights[blk].begin(), weights[blk].end());
+  }
+  return out;
+}
+
 bool SurfaceBinding::snaps() const {
   return options_.snap_to_features && !near_feature_.empty() && feature_count() > 0 && !feature_attachment_.vertex.empty();
 }
@@ -400,10 +439,13 @@ FeatureSnapReport SurfaceBinding::snap(Points& positions, const Points& targets,
   if (static_cast<std::size_t>(targets.rows()) != feature_count() || static_cast<std::size_t>(positions.rows()) != vertex_count_)
     throw Error("surface: the snap's targets or positions do not match the binding");
   // (The chunked pipeline does the same passes: chunked_resize.cpp.)
+  const bool kernel = options_.snap_radius > 0.0;
+  const Csr& reach = kernel ? snap_reach_.reach : blends_.reach;
+  const std::vector<float>& weight = kernel ? snap_reach_.weight : blends_.weight;
   for (int pass = 0; pass < std::max(1, passes > 0 ? passes : options_.snap_passes); ++pass) {
     const Points before = positions;
-    const FeatureSnapReport r = snap_to_features(positions, targets, feature_attachment_, blends_.reach,
-                                                 blends_.weight, feature_of_, held, options_.snap_regularisation);
+    const FeatureSnapReport r = snap_to_features(positions, targets, feature_attachment_, reach, weight, feature_of_,
+                                                 held, options_.snap_regularisation);
     if (pass == 0) total = r;  // every pass moves the same vertices
     total.gap_after = r.gap_after;
     if (!(r.gap_after < r.gap_before)) {  // a pass that does not help is undone

@@ -65,7 +65,10 @@ struct SurfaceOptions {
                                    // held curve with the curve's slope instead of a crease (feature_bend.hpp); 0: off
   bool snap_to_features = true;    // with a feature zone: correct the vertices near the features so that the written
                                    // garment passes through the optimised curves (see feature_snap.hpp)
-  double snap_regularisation = 1e-3;  // Tikhonov weight of that correction, relative to its normal equations' diagonal
+  double snap_radius = 2.0;         // the correction reaches the vertices within this many voxels (h) of each feature
+                                   // sample, weighted (1 - d^2/r^2)^2 (feature_snap.hpp); 0: through the
+                                   // reconstruction's blend weights (which can miss a sample's own corners)
+  double snap_regularisation = 1e-4;  // Tikhonov weight of that correction, relative to its normal equations' diagonal
   int snap_passes = 4;             // the correction repeated on what is left (each pass removes most of the rest where
                                    // the samples do not conflict; the regularisation keeps one pass from overshooting)
   bool keep_clear_of_body = true;  // free agents the solve leaves closer than `clearance` to body B (or inside) are held
@@ -180,6 +183,13 @@ struct VertexBlends {
   std::size_t without_agent = 0;
 };
 
+/// The feature agents whose corrections move each vertex in the snap
+/// (feature_snap.hpp), and their weights, for all vertices or a chunk of them.
+struct SnapReach {
+  Csr reach;                  // per vertex: feature agents (storage slots)
+  std::vector<float> weight;  // parallel to reach.indices
+};
+
 /// The garment's share of a surface binding, found on the original garment:
 /// by SurfaceBinding::bind from a Garment, or chunk by chunk by the chunked
 /// mode (refit/chunked), which then binds with SurfaceBinding::bind_agents.
@@ -245,6 +255,11 @@ class SurfaceBinding {
 
   /// The blends of vertices at `positions` (original garment) of layers `layer` (per row; empty: all 0).
   VertexBlends vertex_blends(const Points& positions, std::span<const std::uint32_t> layer) const;
+
+  /// The snap's reach of vertices at `positions` (original garment) of layers
+  /// `layer`: the feature agents of their layer within snap_radius voxels
+  /// (empty with snap_radius 0: the snap then goes through the blends).
+  SnapReach snap_reach(const Points& positions, std::span<const std::uint32_t> layer) const;
 
   /// apply's agent part, for apply and the chunked mode: the constraints, the
   /// solve with its clearance rounds, the anchored agents, the smoothing, and
@@ -378,6 +393,7 @@ class SurfaceBinding {
   std::vector<Index> group_;         // connected group of each agent (one-ring graph)
   std::size_t groups_ = 0;
   VertexBlends blends_;              // per garment vertex (bind; empty from bind_agents)
+  SnapReach snap_reach_;             // per garment vertex with snap_radius > 0 (bind; empty from bind_agents)
   Points original_vertices_;         // emit_from_original: the garment's original positions
   std::vector<CoarseLevel> levels_;  // coarser levels, finest first (coarse_levels.hpp)
   SurfaceStats stats_;
