@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <functional>
 #include <limits>
 
 namespace refit {
@@ -210,7 +211,7 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
     result.warnings.push_back(std::to_string(body_a_.frames().degenerate) + " degenerate triangles on body A and " +
                               std::to_string(frames_b.degenerate) + " on body B were skipped");
   const PointFile* final_positions = &warped;
-  std::optional<PointFile> surfaced, symmetrised;
+  std::optional<PointFile> surfaced, symmetrised, resnapped, alike;
 
   // Body B is body A wherever the garment is bound, so the warp kept every vertex
   // to the bit: the garment as given is the answer (GarmentBinding::resize).
@@ -285,6 +286,7 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
       std::size_t snap_count = 0;
       bool any_weight = false;  // the snap's weights are not empty
       const bool snaps = surface.snaps();
+      std::function<FeatureSnapReport(PointFile&)> snap_in_passes;  // the snap's passes on a file (set below when it snaps)
       surfaced.emplace(plan_.folder, nv);
       st.vertices_capped = st.vertices_without_agent = 0;
       for_each_chunk(g.positions(), chunk, [&](std::size_t first, const Points& original) {
@@ -338,11 +340,11 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
         // apply_feature_snap adds them), in passes as SurfaceBinding::snap: a pass
         // that would not lower the gap is not applied; the sample vertices move
         // by each pass as the garment's do.
-        const auto apply_pass = [&](const FeatureSnap& snap) {
+        const auto apply_pass = [&](const FeatureSnap& snap, PointFile& file) {
           std::vector<SnapTerm> batch;
           std::size_t next = 0, taken = 0, moved = 0;
           Index previous = std::numeric_limits<Index>::max();
-          for_each_chunk(*surfaced, chunk, [&](std::size_t first, const Points& rows) {
+          for_each_chunk(file, chunk, [&](std::size_t first, const Points& rows) {
             Points s = rows;
             const std::size_t end = first + std::size_t(rows.rows());
             for (;;) {
@@ -359,7 +361,7 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
               previous = t.vertex;
               ++taken;
             }
-            surfaced->write(first, s);
+            file.write(first, s);
           });
           for (auto& [v, sv] : snap_vertices) {
             if (sv.held || sv.weight.empty()) continue;
@@ -370,23 +372,27 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
           }
           return moved;
         };
-        FeatureSnapReport total;
-        const int passes = std::max(1, surface.options().snap_passes);
-        for (int pass = 0; pass < passes; ++pass) {
-          FeatureSnap snap = solve_feature_snap(feature_targets, at, snap_vertices, surface.feature_of(), any_weight,
-                                                surface.options().snap_regularisation);
-          snap.report.gap_after = snapped_gap(snap, feature_targets, at, snap_vertices, surface.feature_of());
-          if (pass == 0) total = snap.report;
-          total.gap_after = snap.report.gap_after;
-          if (!(snap.report.gap_after < snap.report.gap_before)) {
-            total.gap_after = snap.report.gap_before;
-            break;
+        snap_in_passes = [&, apply_pass](PointFile& file) {
+          FeatureSnapReport total;
+          const int passes = std::max(1, surface.options().snap_passes);
+          for (int pass = 0; pass < passes; ++pass) {
+            FeatureSnap snap = solve_feature_snap(feature_targets, at, snap_vertices, surface.feature_of(), any_weight,
+                                                  surface.options().snap_regularisation);
+            snap.report.gap_after = snapped_gap(snap, feature_targets, at, snap_vertices, surface.feature_of());
+            if (pass == 0) total = snap.report;
+            total.gap_after = snap.report.gap_after;
+            if (!(snap.report.gap_after < snap.report.gap_before)) {
+              total.gap_after = snap.report.gap_before;
+              break;
+            }
+            if (snap.correction.size() > 0 && snap_count > 0) {
+              const std::size_t moved = apply_pass(snap, file);
+              if (pass == 0) total.vertices_moved = moved;
+            }
           }
-          if (snap.correction.size() > 0 && snap_count > 0) {
-            const std::size_t moved = apply_pass(snap);
-            if (pass == 0) total.vertices_moved = moved;
-          }
-        }
+          return total;
+        };
+        const FeatureSnapReport total = snap_in_passes(*surfaced);
         st.feature_gap_before_snap = total.gap_before;
         st.feature_gap = total.gap_after;
         st.vertices_snapped = total.vertices_moved;
@@ -404,12 +410,36 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
       // The agents' solve is not exactly mirror-symmetric: a symmetric pair gives a symmetric garment.
       if (symmetric_b) {
         symmetrised.emplace(plan_.folder, nv);
-        const PointGather s(*surfaced, plan_.gather_bytes);
-        for_each_chunk(*surfaced, chunk, [&](std::size_t first, const Points& rows) {
-          symmetrised->write(first, symmetrised_rows(bound_->mirror->records, s, first, rows, bound_->mirror_x,
-                                                     bound_->mirror_tolerance));
-        });
+        {
+          const PointGather s(*surfaced, plan_.gather_bytes);
+          for_each_chunk(*surfaced, chunk, [&](std::size_t first, const Points& rows) {
+            symmetrised->write(first, symmetrised_rows(bound_->mirror->records, s, first, rows, bound_->mirror_x,
+                                                       bound_->mirror_tolerance));
+          });
+        }
         final_positions = &*symmetrised;
+        // The snap again, its moves made alike on both sides (GarmentBinding::surface_step).
+        if (snaps) {
+          Points p;
+          PointGather(*symmetrised, 0).gather(sample_vertices, p);
+          for (std::size_t k = 0; k < sample_vertices.size(); ++k) snap_vertices[sample_vertices[k]].position = row3(p, Index(k));
+          resnapped.emplace(plan_.folder, nv);
+          for_each_chunk(*symmetrised, chunk, [&](std::size_t first, const Points& rows) { resnapped->write(first, rows); });
+          const std::vector<double> gap_symmetrised = carried_curve_gaps(curves, carried(at, *symmetrised));
+          snap_in_passes(*resnapped);
+          alike.emplace(plan_.folder, nv);
+          const PointGather before(*symmetrised, plan_.gather_bytes / 2), after(*resnapped, plan_.gather_bytes / 2);
+          for_each_chunk(*symmetrised, chunk, [&](std::size_t first, const Points& rows) {
+            Points moved;
+            resnapped->read(first, std::size_t(rows.rows()), moved);
+            alike->write(first, symmetrised_move_rows(bound_->mirror->records, before, after, first, rows, moved,
+                                                      bound_->mirror_tolerance));
+          });
+          const bool closer = closer_to_curves(gap_symmetrised, carried_curve_gaps(curves, carried(at, *alike)));
+          if (closer) final_positions = &*alike;  // else the symmetrised garment
+          report["surface"]["snapped_after_symmetrising"] = closer;
+          report["surface"]["feature_gap_symmetrised"] = *std::max_element(gap_symmetrised.begin(), gap_symmetrised.end());
+        }
       }
       feature_before_collision = carried(at, *final_positions);
     }

@@ -286,10 +286,10 @@ ChunkedMirror chunked_mirror_attach(const GarmentStore& g, const PointGather& x,
   return out;
 }
 
-Points symmetrised_rows(const RecordFile<MirrorRecord>& mirror, const PointGather& positions, std::size_t first,
-                        const Points& s, double plane_x, double tolerance) {
-  std::vector<MirrorRecord> rec;
-  mirror.read(first, std::size_t(s.rows()), rec);
+namespace {
+
+// The images (carry_one's sums) of the rows of `rec` within `tolerance`, on `positions`.
+Points images(const std::vector<MirrorRecord>& rec, const PointGather& positions, double tolerance) {
   std::vector<Index> ids;
   for (const MirrorRecord& m : rec)
     if (m.distance() <= tolerance) ids.insert(ids.end(), m.vertex.begin(), m.vertex.end());
@@ -297,17 +297,48 @@ Points symmetrised_rows(const RecordFile<MirrorRecord>& mirror, const PointGathe
   ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
   Points p;
   positions.gather(ids, p);
-  Points out = s;
+  Points out = Points::Zero(Eigen::Index(rec.size()), 3);
   for (std::size_t i = 0; i < rec.size(); ++i) {
     const MirrorRecord& m = rec[i];
     if (!(m.distance() <= tolerance)) continue;
-    // carry_one's sum, then mirror_x.
     Vec3 q(m.offset[0], m.offset[1], m.offset[2]);
     for (int k = 0; k < 3; ++k)
       q += m.weight[k] * row3(p, Index(std::lower_bound(ids.begin(), ids.end(), m.vertex[k]) - ids.begin()));
-    Eigen::RowVector3d mirrored(q.x(), q.y(), q.z());
-    mirrored(0) = (2.0 * plane_x) - q.x();
-    out.row(Eigen::Index(i)) = 0.5 * (s.row(Eigen::Index(i)) + mirrored);
+    out.row(Eigen::Index(i)) = q.transpose();
+  }
+  return out;
+}
+
+}  // namespace
+
+Points symmetrised_move_rows(const RecordFile<MirrorRecord>& mirror, const PointGather& before, const PointGather& after,
+                             std::size_t first, const Points& b, const Points& a, double tolerance) {
+  std::vector<MirrorRecord> rec;
+  mirror.read(first, std::size_t(b.rows()), rec);
+  // As GarmentBinding::mirrored_moves: the image's move (the offsets cancel), mirrored.
+  Points mirrored = images(rec, after, tolerance) - images(rec, before, tolerance);
+  mirrored.col(0) = -mirrored.col(0);
+  Points out = a;
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    const auto r = Eigen::Index(i);
+    if (rec[i].distance() <= tolerance) out.row(r) = b.row(r) + 0.5 * (a.row(r) - b.row(r) + mirrored.row(r));
+  }
+  return out;
+}
+
+Points symmetrised_rows(const RecordFile<MirrorRecord>& mirror, const PointGather& positions, std::size_t first,
+                        const Points& s, double plane_x, double tolerance) {
+  std::vector<MirrorRecord> rec;
+  mirror.read(first, std::size_t(s.rows()), rec);
+  const Points image = images(rec, positions, tolerance);
+  Points out = s;
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    if (!(rec[i].distance() <= tolerance)) continue;
+    // carry_one's sum, then mirror_x.
+    const auto r = Eigen::Index(i);
+    Eigen::RowVector3d mirrored = image.row(r);
+    mirrored(0) = (2.0 * plane_x) - image(r, 0);
+    out.row(r) = 0.5 * (s.row(r) + mirrored);
   }
   return out;
 }

@@ -43,4 +43,10 @@ ChunkedMirror chunked_mirror_attach(const GarmentStore& g, const PointGather& x,
 Points symmetrised_rows(const RecordFile<MirrorRecord>& mirror, const PointGather& positions, std::size_t first,
                         const Points& s, double plane_x, double tolerance);
 
+/// Rows [first, first + b.rows()) of `b` (rows of `before`) with each vertex's
+/// move to `a` (rows of `after`) made, where its image is within `tolerance`,
+/// the mean of its own and its image's move, mirrored (GarmentBinding::symmetrise_moves).
+Points symmetrised_move_rows(const RecordFile<MirrorRecord>& mirror, const PointGather& before, const PointGather& after,
+                             std::size_t first, const Points& b, const Points& a, double tolerance);
+
 }  // namespace refit

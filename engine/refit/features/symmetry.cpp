@@ -179,4 +179,23 @@ void symmetrise_curves(FeatureResult& result, const std::vector<Index>& pairs, d
   }
 }
 
+std::vector<double> carried_curve_gaps(const FeatureResult& result, const Points& carried) {
+  std::vector<double> gaps;
+  Eigen::Index first = 0;
+  for (const CurveResult& c : result.curves) {
+    const Eigen::Index m = c.optimised.rows();
+    if (first + m > carried.rows()) throw Error("feature gaps: fewer carried samples than the curves have");
+    gaps.push_back(m == 0 ? 0.0 : (carried.middleRows(first, m) - c.optimised).rowwise().norm().maxCoeff());
+    first += m;
+  }
+  return gaps;
+}
+
+bool closer_to_curves(const std::vector<double>& before, const std::vector<double>& after) {
+  if (before.size() != after.size() || before.empty()) return false;
+  for (std::size_t k = 0; k < before.size(); ++k)
+    if (!(after[k] <= before[k] * 1.001)) return false;
+  return *std::max_element(after.begin(), after.end()) < *std::max_element(before.begin(), before.end());
+}
+
 }  // namespace refit

@@ -74,6 +74,14 @@ void symmetrise(Points& points, const std::vector<Index>& pairs, double c);
 /// of its partner (rows without one are skipped): 0 for a symmetric set.
 double paired_mirror_error(const Points& points, const std::vector<Index>& pairs, double c);
 
+/// Per curve of `result`, the largest distance from its samples carried on a
+/// garment (`carried`: every curve's samples, concatenated in order) to its optimised curve.
+std::vector<double> carried_curve_gaps(const FeatureResult& result, const Points& carried);
+/// Whether gaps `after` (carried_curve_gaps) are better than `before`: no curve
+/// farther off (beyond a thousandth: rounding), and the farthest closer (the
+/// snap after the symmetrisation is kept only then).
+bool closer_to_curves(const std::vector<double>& before, const std::vector<double>& after);
+
 /// symmetrise() on the optimised samples of every curve (concatenated in order,
 /// as mirror_pairs' samples), then their shape figures measured again.
 void symmetrise_curves(FeatureResult& result, const std::vector<Index>& pairs, double c);

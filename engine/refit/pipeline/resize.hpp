@@ -108,6 +108,11 @@ class GarmentBinding {
                                                       double max_extra) const;
   void metrics_step(const BodySurface& surface_b, ResizeResult& result, const Progress& progress) const;
   void symmetrise_garment(Points& positions) const;
+  /// Per vertex: the move of its mirror image (carried on the garment's faces) from `before` to `after`, mirrored
+  /// about the plane; meaningful where the vertex is paired.
+  Points mirrored_moves(const Points& before, const Points& after) const;
+  /// Each paired vertex's move from `before` to `positions` becomes the mean of its own and its image's, mirrored.
+  void symmetrise_moves(const Points& before, Points& positions) const;
   const Csr& vertex_adjacency_once() const;
   const FoldBinding& folds_once() const;
 

@@ -204,6 +204,7 @@ SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
   st.feature_gap_before_snap = snapped.gap_before;
   st.feature_gap = snapped.gap_after;
   st.vertices_snapped = snapped.vertices_moved;
+  res.kept = std::move(kept_vertex);
   res.agents = std::move(sol.x);
   st.ms.reconstruct = clock.ms();
   return res;

@@ -159,8 +159,9 @@ struct SurfaceStats {
 };
 
 struct SurfaceResult {
-  Points positions;  // every garment vertex
-  Points agents;     // optimised agent positions (storage order)
+  Points positions;                 // every garment vertex
+  Points agents;                    // optimised agent positions (storage order)
+  std::vector<std::uint8_t> kept;   // per vertex: kept at its warped position (the snap leaves it; empty: none)
   SurfaceStats stats;
 };
 
