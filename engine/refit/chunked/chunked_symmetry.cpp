@@ -321,7 +321,9 @@ Points symmetrised_move_rows(const RecordFile<MirrorRecord>& mirror, const Point
   Points out = a;
   for (std::size_t i = 0; i < rec.size(); ++i) {
     const auto r = Eigen::Index(i);
-    if (rec[i].distance() <= tolerance) out.row(r) = b.row(r) + 0.5 * (a.row(r) - b.row(r) + mirrored.row(r));
+    if (!(rec[i].distance() <= tolerance)) continue;
+    if ((a.row(r) - b.row(r)).isZero(0.0) && mirrored.row(r).isZero(0.0)) continue;  // as symmetrise_moves: the row stays
+    out.row(r) = b.row(r) + 0.5 * (a.row(r) - b.row(r) + mirrored.row(r));
   }
   return out;
 }

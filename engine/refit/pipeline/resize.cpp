@@ -321,14 +321,35 @@ Points GarmentBinding::mirrored_moves(const Points& before, const Points& after)
   return mirrored;
 }
 
+// The snap moves a few thousand vertices of a million: only those and the
+// vertices whose mirror image lies on a face they are corners of are looked at
+// (a row whose own and mirrored moves are both zero stays, as in
+// symmetrised_move_rows). New rows are gathered per block, then written.
 void GarmentBinding::symmetrise_moves(const Points& before, Points& positions) const {
-  const Points mirrored = mirrored_moves(before, positions);
-  parallel_for(0, std::size_t(positions.rows()), 4096, [&](std::size_t b, std::size_t e) {
-    for (std::size_t v = b; v < e; ++v) {
-      const auto i = Eigen::Index(v);
-      if (garment_paired_[v]) positions.row(i) = before.row(i) + 0.5 * (positions.row(i) - before.row(i) + mirrored.row(i));
-    }
+  const std::size_t n = std::size_t(positions.rows());
+  std::vector<std::uint8_t> moved(n);
+  parallel_for(0, n, 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t v = b; v < e; ++v) moved[v] = positions.row(Eigen::Index(v)) != before.row(Eigen::Index(v));
   });
+  constexpr std::size_t kBlock = 4096;
+  std::vector<std::vector<std::pair<Index, Vec3>>> rows((n + kBlock - 1) / kBlock);
+  const auto block = [&](std::size_t k) {
+    for (std::size_t v = k * kBlock; v < std::min(n, (k + 1) * kBlock); ++v) {
+      const auto& image = garment_mirror_.vertex[v];
+      if (!garment_paired_[v] || !(moved[v] || moved[image[0]] || moved[image[1]] || moved[image[2]])) continue;
+      const Index i = Index(v);
+      Vec3 other = carry_one(garment_mirror_, positions, i) - carry_one(garment_mirror_, before, i);  // mirrored_moves' row
+      other.x() = -other.x();
+      const Vec3 own = row3(positions, i) - row3(before, i);
+      if (own == Vec3::Zero() && other == Vec3::Zero()) continue;
+      rows[k].emplace_back(i, row3(before, i) + 0.5 * (own + other));
+    }
+  };
+  parallel_for(0, rows.size(), 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) block(k);
+  });
+  for (const auto& r : rows)
+    for (const auto& [i, p] : r) positions.row(i) = p.transpose();
 }
 
 std::vector<std::pair<Index, Vec3>> GarmentBinding::symmetric_pushes(const Points& before, const Points& after,
