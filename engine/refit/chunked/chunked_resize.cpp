@@ -418,25 +418,30 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
           });
         }
         final_positions = &*symmetrised;
-        // The snap again, its moves made alike on both sides (GarmentBinding::surface_step).
+        // The snap again where the symmetrisation took the garment farther off the
+        // curves, its moves made alike on both sides (GarmentBinding::surface_step).
         if (snaps) {
-          Points p;
-          PointGather(*symmetrised, 0).gather(sample_vertices, p);
-          for (std::size_t k = 0; k < sample_vertices.size(); ++k) snap_vertices[sample_vertices[k]].position = row3(p, Index(k));
-          resnapped.emplace(plan_.folder, nv);
-          for_each_chunk(*symmetrised, chunk, [&](std::size_t first, const Points& rows) { resnapped->write(first, rows); });
           const std::vector<double> gap_symmetrised = carried_curve_gaps(curves, carried(at, *symmetrised));
-          snap_in_passes(*resnapped);
-          alike.emplace(plan_.folder, nv);
-          const PointGather before(*symmetrised, plan_.gather_bytes / 2), after(*resnapped, plan_.gather_bytes / 2);
-          for_each_chunk(*symmetrised, chunk, [&](std::size_t first, const Points& rows) {
-            Points moved;
-            resnapped->read(first, std::size_t(rows.rows()), moved);
-            alike->write(first, symmetrised_move_rows(bound_->mirror->records, before, after, first, rows, moved,
-                                                      bound_->mirror_tolerance));
-          });
-          const bool closer = closer_to_curves(gap_symmetrised, carried_curve_gaps(curves, carried(at, *alike)));
-          if (closer) final_positions = &*alike;  // else the symmetrised garment
+          bool closer = false;
+          if (farther_off(carried_curve_gaps(curves, carried(at, *surfaced)), gap_symmetrised)) {
+            Points p;
+            PointGather(*symmetrised, 0).gather(sample_vertices, p);
+            for (std::size_t k = 0; k < sample_vertices.size(); ++k)
+              snap_vertices[sample_vertices[k]].position = row3(p, Index(k));
+            resnapped.emplace(plan_.folder, nv);
+            for_each_chunk(*symmetrised, chunk, [&](std::size_t first, const Points& rows) { resnapped->write(first, rows); });
+            snap_in_passes(*resnapped);
+            alike.emplace(plan_.folder, nv);
+            const PointGather before(*symmetrised, plan_.gather_bytes / 2), after(*resnapped, plan_.gather_bytes / 2);
+            for_each_chunk(*symmetrised, chunk, [&](std::size_t first, const Points& rows) {
+              Points moved;
+              resnapped->read(first, std::size_t(rows.rows()), moved);
+              alike->write(first, symmetrised_move_rows(bound_->mirror->records, before, after, first, rows, moved,
+                                                        bound_->mirror_tolerance));
+            });
+            closer = closer_to_curves(gap_symmetrised, carried_curve_gaps(curves, carried(at, *alike)));
+            if (closer) final_positions = &*alike;  // else the symmetrised garment
+          }
           report["surface"]["snapped_after_symmetrising"] = closer;
           report["surface"]["feature_gap_symmetrised"] = *std::max_element(gap_symmetrised.begin(), gap_symmetrised.end());
         }

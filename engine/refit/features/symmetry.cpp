@@ -191,6 +191,11 @@ std::vector<double> carried_curve_gaps(const FeatureResult& result, const Points
   return gaps;
 }
 
+bool farther_off(const std::vector<double>& before, const std::vector<double>& after) {
+  if (before.empty() || after.empty()) return false;
+  return *std::max_element(after.begin(), after.end()) > *std::max_element(before.begin(), before.end());
+}
+
 bool closer_to_curves(const std::vector<double>& before, const std::vector<double>& after) {
   if (before.size() != after.size() || before.empty()) return false;
   for (std::size_t k = 0; k < before.size(); ++k)

@@ -77,6 +77,8 @@ double paired_mirror_error(const Points& points, const std::vector<Index>& pairs
 /// Per curve of `result`, the largest distance from its samples carried on a
 /// garment (`carried`: every curve's samples, concatenated in order) to its optimised curve.
 std::vector<double> carried_curve_gaps(const FeatureResult& result, const Points& carried);
+/// Whether the farthest of gaps `after` (carried_curve_gaps) is farther off than the farthest of `before`.
+bool farther_off(const std::vector<double>& before, const std::vector<double>& after);
 /// Whether gaps `after` (carried_curve_gaps) are better than `before`: no curve
 /// farther off (beyond a thousandth: rounding), and the farthest closer (the
 /// snap after the symmetrisation is kept only then).
