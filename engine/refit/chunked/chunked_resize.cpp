@@ -307,9 +307,8 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
         surfaced->write(first, s);
         if (!snaps) return;
         // The snap's reach: its own (snap_radius > 0) or the blends', as SurfaceBinding::snap takes it.
-        SnapReach own_reach;
-        if (surface.options().snap_radius > 0.0) own_reach = surface.snap_reach(original, layer);
         const bool kernel = surface.options().snap_radius > 0.0;
+        const SnapReach own_reach = kernel ? surface.snap_reach(original, layer) : SnapReach{};
         const Csr& reach = kernel ? own_reach.reach : blends.reach;
         const std::vector<float>& weight = kernel ? own_reach.weight : blends.weight;
         any_weight = any_weight || !weight.empty();

@@ -443,10 +443,11 @@ Points GarmentBinding::surface_step(const BodySurface& surface_b, bool symmetric
     // elsewhere its small moves next to the body gave the collision step
     // corners to push (the 135k dress on F_shorter: written 0.004 -> 0.017 cm).
     if (snaps) {
-      const Points before = result.positions;
-      const std::vector<double> symmetrised = carried_curve_gaps(result.features, carry(feature_attachment_, before));
+      const std::vector<double> symmetrised =
+          carried_curve_gaps(result.features, carry(feature_attachment_, result.positions));
       bool closer = false;
       if (farther_off(snapped, symmetrised)) {
+        const Points before = result.positions;  // a copy of the garment only when the snap runs
         surface_->snap(result.positions, feature_targets, s.kept);
         symmetrise_moves(before, result.positions);
         closer = closer_to_curves(symmetrised,
