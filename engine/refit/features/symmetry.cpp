@@ -196,10 +196,10 @@ bool farther_off(const std::vector<double>& before, const std::vector<double>& a
   return *std::max_element(after.begin(), after.end()) > *std::max_element(before.begin(), before.end());
 }
 
-bool closer_to_curves(const std::vector<double>& before, const std::vector<double>& after) {
+bool closer_to_curves(const std::vector<double>& before, const std::vector<double>& after, double slack) {
   if (before.size() != after.size() || before.empty()) return false;
   for (std::size_t k = 0; k < before.size(); ++k)
-    if (!(after[k] <= before[k] * 1.001)) return false;
+    if (!(after[k] <= before[k] * 1.001 + slack)) return false;
   return *std::max_element(after.begin(), after.end()) < *std::max_element(before.begin(), before.end());
 }
 

@@ -81,8 +81,9 @@ std::vector<double> carried_curve_gaps(const FeatureResult& result, const Points
 bool farther_off(const std::vector<double>& before, const std::vector<double>& after);
 /// Whether gaps `after` (carried_curve_gaps) are better than `before`: no curve
 /// farther off (beyond a thousandth: rounding), and the farthest closer (the
-/// snap after the symmetrisation is kept only then).
-bool closer_to_curves(const std::vector<double>& before, const std::vector<double>& after);
+/// snap after the symmetrisation is kept only then). `slack`: what a curve
+/// may come out farther off beyond that (garment units).
+bool closer_to_curves(const std::vector<double>& before, const std::vector<double>& after, double slack = 0.0);
 
 /// symmetrise() on the optimised samples of every curve (concatenated in order,
 /// as mirror_pairs' samples), then their shape figures measured again.

@@ -237,23 +237,93 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
     return result;
   }
 
-  const Stopwatch features_clock;  // the feature step's time counts body B's surface
+  const Stopwatch body_clock;  // the feature step's time counts body B's surface
   const BodySurface surface_b(body_b);
   const bool symmetric_b = body_b_symmetric(body_b, result.report);
+  const double body_ms = body_clock.ms();
+  const nlohmann::json warp_report = result.report;  // a second pass starts from the warp again
+  const std::vector<std::string> warp_warnings = result.warnings;
+  Points feature_before_collision = shape_steps(frames_b, surface_b, symmetric_b, {}, result, progress);
+  if (surface_ && !result.features.curves.empty()) {
+    Points written = carry(feature_attachment_, result.positions);
+    // Where the collision step pushed a curve's faces off a bulge of body B
+    // that the curve's own clearance did not see (a coarse face over the hips
+    // of a heavier body), the curve is solved again at least as far off as
+    // the push left it, so the surface follows it there and the step need not
+    // push it (the shared skirt on a body heavier than F_heavier: 0.16 cm off
+    // its curve after one pass). Kept only when every curve ends closer.
+    const std::vector<double> lift =
+        options_.collision ? lifts_from_pushes(surface_b, result.features, feature_before_collision, written)
+                           : std::vector<double>();
+    bool lifted = false;
+    if (!lift.empty()) {
+      const Stopwatch again_clock;
+      ResizeResult again{result.warped, result.warped, {}, warp_report, warp_warnings};
+      Points again_before = shape_steps(frames_b, surface_b, symmetric_b, lift, again, progress);
+      Points again_written = carry(feature_attachment_, again.positions);
+      if (closer_to_curves(carried_curve_gaps(result.features, written),
+                           carried_curve_gaps(again.features, again_written),
+                           kPushedCurveToleranceCm * units_per_cm(options_.units))) {
+        result = std::move(again);
+        feature_before_collision = std::move(again_before);
+        written = std::move(again_written);
+        lifted = true;
+      }
+      result.report["timings_ms"]["lift_pass"] = again_clock.ms();  // the steps again, kept or not
+    }
+    if (options_.collision) result.report["surface"]["lifted_off_pushes"] = lifted;
+    report_written_features(result.features, written, carry(feature_attachment_, result.warped),
+                            feature_before_collision, result.report);
+  }
+  if (features_) result.report["timings_ms"]["features"] = result.report["timings_ms"]["features"].get<double>() + body_ms;
+  if (options_.metrics) metrics_step(surface_b, result, progress);
+  return result;
+}
+
+Points GarmentBinding::shape_steps(const TriangleFrames& frames_b, const BodySurface& surface_b, bool symmetric_b,
+                                   const std::vector<double>& lift, ResizeResult& result,
+                                   const Progress& progress) const {
   // Step 2: feature curves keep their shape (section 4).
-  if (features_) feature_step(frames_b, surface_b, symmetric_b, features_clock, result, progress);
+  if (features_) feature_step(frames_b, surface_b, symmetric_b, lift, Stopwatch(), result, progress);
   // Step 3: the surface follows the curves and keeps its local shape (section 5).
   Points feature_before_collision;
   if (surface_) feature_before_collision = surface_step(surface_b, symmetric_b, result, progress);
   if (!result.positions.allFinite()) throw Error("internal: the surface step produced a non-finite position");
   // Beyond the paper: nothing of the garment may end inside body B.
   if (surface_ && options_.collision) collision_step(surface_b, symmetric_b, result, progress);
+  return feature_before_collision;
+}
 
-  if (surface_ && !result.features.curves.empty())
-    report_written_features(result.features, carry(feature_attachment_, result.positions),
-                            carry(feature_attachment_, result.warped), feature_before_collision, result.report);
-  if (options_.metrics) metrics_step(surface_b, result, progress);
-  return result;
+std::vector<double> GarmentBinding::lifts_from_pushes(const BodySurface& surface_b, const FeatureResult& curves,
+                                                      const Points& before, const Points& after) const {
+  if (!options_.lift_pushed_curves || options_.follow_body_cm > 0.0) return {};  // with follow-body the curves follow body B
+  const double per_cm = units_per_cm(options_.units), tolerance = kPushedCurveToleranceCm * per_cm;
+  const std::vector<double> gaps_before = carried_curve_gaps(curves, before), gaps_after = carried_curve_gaps(curves, after);
+  // Only where the written garment misses a curve: a lifted curve keeps its
+  // shape less well (the outfit's profiles on F_shorter 8.9x closer to their
+  // original shape than the warp after one pass, 4.4x after the lift).
+  if (!(*std::max_element(gaps_after.begin(), gaps_after.end()) > kFollowedCurveGapCm * per_cm)) return {};
+  std::vector<double> lift(static_cast<std::size_t>(after.rows()), 0.0);
+  bool any = false;
+  Eigen::Index first = 0;
+  for (std::size_t c = 0; c < curves.curves.size(); ++c) {
+    const Eigen::Index m = curves.curves[c].original.rows();
+    if (gaps_after[c] > gaps_before[c] + tolerance) {
+      // Each pushed sample keeps at least the distance from body B the push gave it.
+      for (Eigen::Index i = first; i < first + m; ++i) {
+        if ((after.row(i) - before.row(i)).norm() <= tolerance) continue;
+        lift[static_cast<std::size_t>(i)] = surface_b.closest(row3(after, i)).distance;
+        any = true;
+      }
+    }
+    first += m;
+  }
+  if (!any) return {};
+  // Both sides of a symmetric pair alike: the feature step makes its curves so.
+  for (std::size_t i = 0; i < feature_mirror_.size() && i < lift.size(); ++i)
+    if (feature_mirror_[i] != kNoMirror) lift[i] = lift[static_cast<std::size_t>(feature_mirror_[i])] =
+        std::max(lift[i], lift[static_cast<std::size_t>(feature_mirror_[i])]);
+  return lift;
 }
 
 TriangleFrames GarmentBinding::warp_step(const BodyMesh& body_b, ResizeResult& result, const Progress& progress) const {
@@ -377,7 +447,8 @@ std::vector<std::pair<Index, Vec3>> GarmentBinding::symmetric_pushes(const Point
 }
 
 void GarmentBinding::feature_step(const TriangleFrames& frames_b, const BodySurface& surface_b, bool symmetric_b,
-                                  const Stopwatch& clock, ResizeResult& result, const Progress& progress) const {
+                                  const std::vector<double>& lift, const Stopwatch& clock, ResizeResult& result,
+                                  const Progress& progress) const {
   progress.stage("optimising " + std::to_string(features_->model.curves.size()) + " feature curves");
   if (features_->model.options.clearance > 0.0) surface_b.prepare_inside_test();
   FeatureResult& curves = result.features;
@@ -395,6 +466,11 @@ void GarmentBinding::feature_step(const TriangleFrames& frames_b, const BodySurf
       if (!close) extra[i] = 0.0;
     }
   });
+  if (!lift.empty()) {
+    if (extra.empty()) extra.assign(lift.size(), 0.0);
+    const double base = features_->model.options.clearance;
+    for (std::size_t i = 0; i < lift.size(); ++i) extra[i] = std::max(extra[i], lift[i] - base);
+  }
   curves = optimise_features(
       *features_, frames_b, [&](const Vec3& p) { return surface_b.closest(p).distance; },
       [&](const Vec3& p, double clearance) { return clearance_need(surface_b, p, clearance); }, extra);

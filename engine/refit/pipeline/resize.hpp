@@ -58,6 +58,10 @@ struct ResizeOptions {
   /// body B. 0 (default): the curves keep their shape there too (docs/method.md
   /// has the quality suite's figures of both).
   double follow_body_cm = 0.0;
+  /// With the collision step: when it pushes a curve's faces farther than
+  /// kFollowedCurveGapCm off the curve, the shape steps run again with the
+  /// curve kept as far off body B as the push left it (docs/method.md).
+  bool lift_pushed_curves = true;
   bool metrics = false;        // add fit, penetration and sanity metrics (warp and result) to the report
   double memory_budget_mb = 0; // a run estimated above this is refused before the work (0: the machine's memory)
 };
@@ -95,8 +99,19 @@ class GarmentBinding {
   // report, its time and its warnings to `result`.
   TriangleFrames warp_step(const BodyMesh& body_b, ResizeResult& result, const Progress& progress) const;
   bool body_b_symmetric(const BodyMesh& body_b, nlohmann::json& report) const;
+  /// `lift`: per feature sample (or empty), a clearance it keeps at least beyond the option's.
   void feature_step(const TriangleFrames& frames_b, const BodySurface& surface_b, bool symmetric_b,
-                    const Stopwatch& clock, ResizeResult& result, const Progress& progress) const;
+                    const std::vector<double>& lift, const Stopwatch& clock, ResizeResult& result,
+                    const Progress& progress) const;
+  /// Steps 2 to 4 on `result` (warped): features, surface, collision. Returns
+  /// the feature samples carried where the surface step leaves them.
+  Points shape_steps(const TriangleFrames& frames_b, const BodySurface& surface_b, bool symmetric_b,
+                     const std::vector<double>& lift, ResizeResult& result, const Progress& progress) const;
+  /// Per feature sample: the clearance from body B that keeps it where the
+  /// collision step pushed it (carried from `before` to `after`), for the
+  /// samples whose curve the step took farther off; empty when none.
+  std::vector<double> lifts_from_pushes(const BodySurface& surface_b, const FeatureResult& curves,
+                                        const Points& before, const Points& after) const;
   /// Per feature sample (all curves in order, at `samples` on the original), the
   /// clearance it keeps beyond the option's where a face under it dips towards body A.
   std::vector<double> dipping_face_clearance(const Points& samples) const;
@@ -155,6 +170,13 @@ inline constexpr const char* kVersion = "0.1.0";
 inline constexpr double kFeatureClearanceMarginCm = 0.05;
 /// The most a feature sample stands farther off body B for a face under it that dips (dipping_face_clearance).
 inline constexpr double kDippingFaceCapCm = 1.0;
+/// The pipeline runs its shape steps again, with the curves lifted where the
+/// collision step pushed them, when that step leaves a curve farther off the
+/// written garment than kFollowedCurveGapCm and this much farther than the
+/// surface step left it (lifts_from_pushes).
+inline constexpr double kPushedCurveToleranceCm = 0.01;
+/// A curve the written garment passes within this of counts as followed (issue 13's feature gap target).
+inline constexpr double kFollowedCurveGapCm = 0.05;
 /// The collision step's pushes of a symmetric pair are made alike when they differ by more than this.
 inline constexpr double kSymmetricPushToleranceCm = 0.02;
 
