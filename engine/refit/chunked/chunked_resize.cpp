@@ -438,7 +438,8 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
               alike->write(first, symmetrised_move_rows(bound_->mirror->records, before, after, first, rows, moved,
                                                         bound_->mirror_tolerance));
             });
-            closer = closer_to_curves(gap_symmetrised, carried_curve_gaps(curves, carried(at, *alike)));
+            closer = closer_to_curves(gap_symmetrised, carried_curve_gaps(curves, carried(at, *alike)),
+                                      kNegligibleGapChangeCm * units_per_cm(options_.units));
             if (closer) final_positions = &*alike;  // else the symmetrised garment
           }
           report["surface"]["snapped_after_symmetrising"] = closer;

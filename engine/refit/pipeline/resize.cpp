@@ -527,7 +527,8 @@ Points GarmentBinding::surface_step(const BodySurface& surface_b, bool symmetric
         surface_->snap(result.positions, feature_targets, s.kept);
         symmetrise_moves(before, result.positions);
         closer = closer_to_curves(symmetrised,
-                                  carried_curve_gaps(result.features, carry(feature_attachment_, result.positions)));
+                                  carried_curve_gaps(result.features, carry(feature_attachment_, result.positions)),
+                                  kNegligibleGapChangeCm * units_per_cm(options_.units));
         if (!closer) result.positions = before;
       }
       result.report["surface"]["snapped_after_symmetrising"] = closer;

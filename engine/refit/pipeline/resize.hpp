@@ -175,6 +175,9 @@ inline constexpr double kDippingFaceCapCm = 1.0;
 /// written garment than kFollowedCurveGapCm and this much farther than the
 /// surface step left it (lifts_from_pushes).
 inline constexpr double kPushedCurveToleranceCm = 0.01;
+/// What a curve may come out farther off where a step that brings the farthest
+/// closer is kept (the snap after the symmetrisation): a hundredth of a millimetre.
+inline constexpr double kNegligibleGapChangeCm = 0.001;
 /// A curve the written garment passes within this of counts as followed (issue 13's feature gap target).
 inline constexpr double kFollowedCurveGapCm = 0.05;
 /// The collision step's pushes of a symmetric pair are made alike when they differ by more than this.
