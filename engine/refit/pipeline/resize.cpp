@@ -252,9 +252,7 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
     // the push left it, so the surface follows it there and the step need not
     // push it (the shared skirt on a body heavier than F_heavier: 0.16 cm off
     // its curve after one pass). Kept only when every curve ends closer.
-    const std::vector<double> lift =
-        options_.collision ? lifts_from_pushes(surface_b, result.features, feature_before_collision, written)
-                           : std::vector<double>();
+    const std::vector<double> lift = lifts_from_pushes(surface_b, result.features, feature_before_collision, written);
     bool lifted = false;
     if (!lift.empty()) {
       const Stopwatch again_clock;
@@ -284,7 +282,7 @@ Points GarmentBinding::shape_steps(const TriangleFrames& frames_b, const BodySur
                                    const std::vector<double>& lift, ResizeResult& result,
                                    const Progress& progress) const {
   // Step 2: feature curves keep their shape (section 4).
-  if (features_) feature_step(frames_b, surface_b, symmetric_b, lift, Stopwatch(), result, progress);
+  if (features_) feature_step(frames_b, surface_b, symmetric_b, lift, result, progress);
   // Step 3: the surface follows the curves and keeps its local shape (section 5).
   Points feature_before_collision;
   if (surface_) feature_before_collision = surface_step(surface_b, symmetric_b, result, progress);
@@ -296,7 +294,8 @@ Points GarmentBinding::shape_steps(const TriangleFrames& frames_b, const BodySur
 
 std::vector<double> GarmentBinding::lifts_from_pushes(const BodySurface& surface_b, const FeatureResult& curves,
                                                       const Points& before, const Points& after) const {
-  if (!options_.lift_pushed_curves || options_.follow_body_cm > 0.0) return {};  // with follow-body the curves follow body B
+  // Only the collision step pushes; with follow-body the curves follow body B instead.
+  if (!options_.collision || !options_.lift_pushed_curves || options_.follow_body_cm > 0.0) return {};
   const double per_cm = units_per_cm(options_.units), tolerance = kPushedCurveToleranceCm * per_cm;
   const std::vector<double> gaps_before = carried_curve_gaps(curves, before), gaps_after = carried_curve_gaps(curves, after);
   // Only where the written garment misses a curve: a lifted curve keeps its
@@ -447,8 +446,9 @@ std::vector<std::pair<Index, Vec3>> GarmentBinding::symmetric_pushes(const Point
 }
 
 void GarmentBinding::feature_step(const TriangleFrames& frames_b, const BodySurface& surface_b, bool symmetric_b,
-                                  const std::vector<double>& lift, const Stopwatch& clock, ResizeResult& result,
+                                  const std::vector<double>& lift, ResizeResult& result,
                                   const Progress& progress) const {
+  const Stopwatch clock;
   progress.stage("optimising " + std::to_string(features_->model.curves.size()) + " feature curves");
   if (features_->model.options.clearance > 0.0) surface_b.prepare_inside_test();
   FeatureResult& curves = result.features;

@@ -101,8 +101,7 @@ class GarmentBinding {
   bool body_b_symmetric(const BodyMesh& body_b, nlohmann::json& report) const;
   /// `lift`: per feature sample (or empty), a clearance it keeps at least beyond the option's.
   void feature_step(const TriangleFrames& frames_b, const BodySurface& surface_b, bool symmetric_b,
-                    const std::vector<double>& lift, const Stopwatch& clock, ResizeResult& result,
-                    const Progress& progress) const;
+                    const std::vector<double>& lift, ResizeResult& result, const Progress& progress) const;
   /// Steps 2 to 4 on `result` (warped): features, surface, collision. Returns
   /// the feature samples carried where the surface step leaves them.
   Points shape_steps(const TriangleFrames& frames_b, const BodySurface& surface_b, bool symmetric_b,
