@@ -232,6 +232,40 @@ TEST(BodySurface, ClosestWithinHonoursTheRadius) {
   EXPECT_FALSE(s.inside(far));
 }
 
+TEST(BodySurface, CloserThanAnswersAsClosestWithin) {
+  // Points from on the surface to beyond the radius, radii from small to the
+  // sphere's size, and points exactly at the radius off a vertex (along its
+  // normal: the distance is the radius, so "closer than" is no): the early-ending
+  // search answers as the closest point's distance does, exactly.
+  const BodyMesh m = test::icosphere(3, 5.0, Vec3(1, 2, 3));
+  const BodySurface s(m);
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<std::size_t> pick(0, m.vertices.rows() - 1);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::size_t yes = 0, no = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const Vec3 dir3 = Vec3(unit(rng), unit(rng), unit(rng)).normalized();
+    const double offset = std::array<double, 5>{0.0, 0.05, 0.4, 1.0, 6.0}[std::size_t(i) % 5];
+    const Vec3 p = row3(m.vertices, Index(pick(rng))) + offset * dir3;
+    for (double radius : {0.05, 0.5, 1.0, 4.0}) {
+      const bool expected = s.closest_within(p, radius).distance < radius;
+      ASSERT_EQ(s.closer_than(p, radius), expected) << i << " radius " << radius;
+      (expected ? yes : no) += 1;
+    }
+  }
+  for (Index v = 0; v < 40; ++v) {
+    const Vec3 out = (row3(m.vertices, v) - Vec3(1, 2, 3)).normalized();
+    const double d = s.closest(row3(m.vertices, v) + 0.3 * out).distance;
+    EXPECT_EQ(s.closer_than(row3(m.vertices, v) + 0.3 * out, d), s.closest_within(row3(m.vertices, v) + 0.3 * out, d).distance < d);
+    EXPECT_FALSE(s.closer_than(row3(m.vertices, v) + 0.3 * out, d));  // at the radius exactly: not closer
+    EXPECT_TRUE(s.closer_than(row3(m.vertices, v) + 0.3 * out, std::nextafter(d, 1.0)));
+  }
+  EXPECT_GT(yes, 1000u);
+  EXPECT_GT(no, 1000u);
+  EXPECT_FALSE(s.closer_than(Vec3(std::nan(""), 0, 0), 1.0));
+  EXPECT_FALSE(s.closer_than(row3(m.vertices, 0), 0.0));
+}
+
 TEST(BodySurface, BadBodyThrowsNamingTheFile) {
   BodyMesh m = test::icosphere(1, 1.0, Vec3::Zero());
   m.path = "bodies/bad.obj";

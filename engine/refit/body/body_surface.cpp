@@ -141,6 +141,31 @@ bool point_query_callback(RTCPointQueryFunctionArguments* args) {
   return false;
 }
 
+// closer_than's search: stops (radius 0) at the first triangle that passes
+// closest_within's two tests, the clamp to max_distance and distance < max_distance.
+struct CloserThanData {
+  const Points* vertices;
+  const std::vector<std::array<Index, 3>>* triangles;
+  const std::vector<std::uint8_t>* degenerate;
+  Vec3 p;
+  double max_distance;
+  bool found = false;
+};
+
+bool closer_than_callback(RTCPointQueryFunctionArguments* args) {
+  auto* d = static_cast<CloserThanData*>(args->userPtr);
+  const Index t = args->primID;
+  if (d->found || (*d->degenerate)[t]) return false;
+  const auto& tri = (*d->triangles)[t];
+  const TrianglePoint tp = closest_on_triangle(d->p, row3(*d->vertices, tri[0]), row3(*d->vertices, tri[1]),
+                                               row3(*d->vertices, tri[2]));
+  const double d2 = (tp.point - d->p).squaredNorm();
+  if (!(d2 <= d->max_distance * d->max_distance) || !(std::sqrt(d2) < d->max_distance)) return false;
+  d->found = true;
+  args->query->radius = 0.0f;
+  return true;
+}
+
 }  // namespace
 
 struct BodySurface::Impl {
@@ -176,8 +201,9 @@ struct BodySurface::Impl {
     if (device) rtcReleaseDevice(device);
   }
 
-  PointQueryData query(const Vec3& p, double max_distance) const {
-    PointQueryData d{&vertices, &triangles, &degenerate, p};
+  // Embree calls `callback` with `data` for each triangle whose bounds meet the
+  // ball of radius max_distance about p (a little larger: float rounding).
+  void point_query(const Vec3& p, double max_distance, RTCPointQueryFunction callback, void* data) const {
     RTCPointQuery q;
     q.x = static_cast<float>(p.x());
     q.y = static_cast<float>(p.y());
@@ -187,7 +213,12 @@ struct BodySurface::Impl {
                                            : std::numeric_limits<float>::infinity();
     RTCPointQueryContext ctx;
     rtcInitPointQueryContext(&ctx);
-    rtcPointQuery(scene, &q, &ctx, point_query_callback, &d);
+    rtcPointQuery(scene, &q, &ctx, callback, data);
+  }
+
+  PointQueryData query(const Vec3& p, double max_distance) const {
+    PointQueryData d{&vertices, &triangles, &degenerate, p};
+    point_query(p, max_distance, point_query_callback, &d);
     if (d.best_d2 > max_distance * max_distance) d.best_d2 = kInf;
     return d;
   }
@@ -523,6 +554,13 @@ ClosestPoint closest_of(const PointQueryData& d, const Points& face_normal) {
 
 ClosestPoint BodySurface::closest_within(const Vec3& p, double max_distance) const {
   return closest_of(impl_->query(p, max_distance), impl_->face_normal);
+}
+
+bool BodySurface::closer_than(const Vec3& p, double max_distance) const {
+  if (!p.allFinite() || !(max_distance > 0.0)) return false;
+  CloserThanData d{&impl_->vertices, &impl_->triangles, &impl_->degenerate, p, max_distance};
+  impl_->point_query(p, max_distance, closer_than_callback, &d);
+  return d.found;
 }
 
 SignedClosestPoint BodySurface::signed_closest_within(const Vec3& p, double max_distance) const {

@@ -461,7 +461,7 @@ void GarmentBinding::feature_step(const TriangleFrames& frames_b, const BodySurf
       bool close = false;
       for (const Index v : feature_attachment_.vertex[i]) {
         const Vec3 p = row3(result.warped, v);
-        close = close || surface_b.inside(p) || surface_b.closest_within(p, clearance).distance < clearance;
+        close = close || surface_b.inside(p) || surface_b.closer_than(p, clearance);
       }
       if (!close) extra[i] = 0.0;
     }
