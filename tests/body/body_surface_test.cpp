@@ -254,11 +254,11 @@ TEST(BodySurface, CloserThanAnswersAsClosestWithin) {
     }
   }
   for (Index v = 0; v < 40; ++v) {
-    const Vec3 out = (row3(m.vertices, v) - Vec3(1, 2, 3)).normalized();
-    const double d = s.closest(row3(m.vertices, v) + 0.3 * out).distance;
-    EXPECT_EQ(s.closer_than(row3(m.vertices, v) + 0.3 * out, d), s.closest_within(row3(m.vertices, v) + 0.3 * out, d).distance < d);
-    EXPECT_FALSE(s.closer_than(row3(m.vertices, v) + 0.3 * out, d));  // at the radius exactly: not closer
-    EXPECT_TRUE(s.closer_than(row3(m.vertices, v) + 0.3 * out, std::nextafter(d, 1.0)));
+    const Vec3 q = row3(m.vertices, v) + 0.3 * (row3(m.vertices, v) - Vec3(1, 2, 3)).normalized();
+    const double d = s.closest(q).distance;
+    EXPECT_EQ(s.closer_than(q, d), s.closest_within(q, d).distance < d);
+    EXPECT_FALSE(s.closer_than(q, d));  // at the radius exactly: not closer
+    EXPECT_TRUE(s.closer_than(q, std::nextafter(d, 1.0)));
   }
   EXPECT_GT(yes, 1000u);
   EXPECT_GT(no, 1000u);

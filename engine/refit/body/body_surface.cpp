@@ -17,6 +17,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <mutex>
 #include <string>
 #include <utility>
@@ -120,19 +121,25 @@ struct PointQueryData {
   int region = 0;
 };
 
+// The closest point of triangle t to d.p; nullopt for a degenerate triangle
+// (its points lie on neighbours' edges anyway).
+std::optional<TrianglePoint> triangle_point(const PointQueryData& d, Index t) {
+  if ((*d.degenerate)[t]) return std::nullopt;
+  const auto& tri = (*d.triangles)[t];
+  return closest_on_triangle(d.p, row3(*d.vertices, tri[0]), row3(*d.vertices, tri[1]), row3(*d.vertices, tri[2]));
+}
+
 bool point_query_callback(RTCPointQueryFunctionArguments* args) {
   auto* d = static_cast<PointQueryData*>(args->userPtr);
   const Index t = args->primID;
-  if ((*d->degenerate)[t]) return false;  // its points lie on neighbours' edges anyway
-  const auto& tri = (*d->triangles)[t];
-  const TrianglePoint tp = closest_on_triangle(d->p, row3(*d->vertices, tri[0]), row3(*d->vertices, tri[1]),
-                                               row3(*d->vertices, tri[2]));
-  const double d2 = (tp.point - d->p).squaredNorm();
+  const std::optional<TrianglePoint> tp = triangle_point(*d, t);
+  if (!tp) return false;
+  const double d2 = (tp->point - d->p).squaredNorm();
   if (d2 < d->best_d2 || (d2 == d->best_d2 && t < d->tri)) {  // ties: lowest index, for determinism
     d->best_d2 = d2;
     d->tri = t;
-    d->point = tp.point;
-    d->region = tp.region;
+    d->point = tp->point;
+    d->region = tp->region;
     // Slightly larger than the double distance so float rounding never culls
     // an equally close triangle.
     args->query->radius = static_cast<float>(std::sqrt(d2) * (1.0 + 1e-6)) + 1e-30f;
@@ -144,22 +151,17 @@ bool point_query_callback(RTCPointQueryFunctionArguments* args) {
 // closer_than's search: stops (radius 0) at the first triangle that passes
 // closest_within's two tests, the clamp to max_distance and distance < max_distance.
 struct CloserThanData {
-  const Points* vertices;
-  const std::vector<std::array<Index, 3>>* triangles;
-  const std::vector<std::uint8_t>* degenerate;
-  Vec3 p;
+  PointQueryData query;
   double max_distance;
   bool found = false;
 };
 
 bool closer_than_callback(RTCPointQueryFunctionArguments* args) {
   auto* d = static_cast<CloserThanData*>(args->userPtr);
-  const Index t = args->primID;
-  if (d->found || (*d->degenerate)[t]) return false;
-  const auto& tri = (*d->triangles)[t];
-  const TrianglePoint tp = closest_on_triangle(d->p, row3(*d->vertices, tri[0]), row3(*d->vertices, tri[1]),
-                                               row3(*d->vertices, tri[2]));
-  const double d2 = (tp.point - d->p).squaredNorm();
+  if (d->found) return false;
+  const std::optional<TrianglePoint> tp = triangle_point(d->query, args->primID);
+  if (!tp) return false;
+  const double d2 = (tp->point - d->query.p).squaredNorm();
   if (!(d2 <= d->max_distance * d->max_distance) || !(std::sqrt(d2) < d->max_distance)) return false;
   d->found = true;
   args->query->radius = 0.0f;
@@ -558,7 +560,7 @@ ClosestPoint BodySurface::closest_within(const Vec3& p, double max_distance) con
 
 bool BodySurface::closer_than(const Vec3& p, double max_distance) const {
   if (!p.allFinite() || !(max_distance > 0.0)) return false;
-  CloserThanData d{&impl_->vertices, &impl_->triangles, &impl_->degenerate, p, max_distance};
+  CloserThanData d{{&impl_->vertices, &impl_->triangles, &impl_->degenerate, p}, max_distance};
   impl_->point_query(p, max_distance, closer_than_callback, &d);
   return d.found;
 }
