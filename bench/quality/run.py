@@ -12,7 +12,8 @@ Blender's Surface Deform, scored from the written files by bench/quality/meshes.
 
 Prints one Markdown row per garment, body and method, then the worst figure of each
 method against issue 13's targets. With --assert, exits 1 when Refit misses a target
-listed in ASSERTED (the ones the engine holds today; CTest runs --quick --assert).
+listed in ASSERTED (the ones the engine holds today; CTest runs --quick --assert), and on
+the shared bodies those in ASSERTED_SHARED_ONLY.
 Exits 77 (CTest's skip) when the shared data is absent. --check-bodies runs the same on
 bodies made here from the shared ones (CHECK: combined and stronger morphs), to see
 whether what holds on the shared bodies holds off them. --dense adds the garments of
@@ -90,7 +91,13 @@ TARGET_TEXT = {
 # Face interiors since the collision step probes a coarse face's points over body B's
 # vertices (2026-11-27): 0 in all 22 cases, scored at 21 points per fan triangle; and
 # with the points over body B's vertices too since the rounds over what is left inside.
-ASSERTED = ["flipped", "inside_vertices", "inside_faces"]
+# The mirror error, the height ratio and the level hem since 2026-11-28 (held in all 22
+# cases and on the CHECK bodies since the symmetric pushes twice and the level hems).
+ASSERTED = ["flipped", "inside_vertices", "inside_faces", "mirror", "height", "hem_level"]
+# The written feature gap holds in all 22 shared cases (since the snap after the
+# symmetrisation) but not on the CHECK bodies (6 of 21, up to 0.11 cm: a coarse face
+# cannot bend with a curve the clearance pushed out), so it is asserted on the shared ones only.
+ASSERTED_SHARED_ONLY = ["feature_gap"]
 # A face of the input this far inside body A (cm) marks its corners: see input_sunk.
 INPUT_SUNK_CM = 0.1
 
@@ -461,7 +468,8 @@ def main():
         with open(args.json, "w") as f:
             json.dump(dump, f, indent=1)
     if args.check:
-        bad = [k for k in ASSERTED if k in failures.get("refit", {})]
+        asserted = ASSERTED + ([] if args.check_bodies else ASSERTED_SHARED_ONLY)
+        bad = [k for k in asserted if k in failures.get("refit", {})]
         if bad:
             print("quality suite: Refit misses asserted targets: " + ", ".join(TARGET_TEXT[k] for k in bad))
             return 1
