@@ -2,7 +2,10 @@
 // corner texture coordinates (every index form, relative ones too) and the
 // `o` / `g` group of every face.
 #include <refit/io/obj_attributes.hpp>
+#include <refit/core/error.hpp>
 #include <refit/io/obj_garment.hpp>
+
+#include "support/test_support.hpp"
 
 #include <gtest/gtest.h>
 
@@ -48,6 +51,17 @@ TEST(ObjAttributes, SameAcrossChunksAndWithoutASource) {
   const ObjFaceAttributes b = obj_face_attributes(bare);
   EXPECT_TRUE(b.corner_texcoords.empty());
   EXPECT_EQ(b.face_groups.size(), 40000u);
+  // A source whose text was released (the resize command's) is read again from its file.
+  test::TempDir dir;
+  test::write_text(dir.file("big.obj"), obj);
+  const Garment released = read_garment_obj(dir.file("big.obj"), SourceText::released);
+  ASSERT_TRUE(released.source->released());
+  const ObjFaceAttributes c = obj_face_attributes(released);
+  EXPECT_EQ(c.face_groups, a.face_groups);
+  EXPECT_EQ(c.group_names, a.group_names);
+  EXPECT_EQ(c.corner_texcoords, a.corner_texcoords);
+  test::write_text(dir.file("big.obj"), obj + "f 1 2 3\n");
+  EXPECT_THROW(obj_face_attributes(released), Error) << "a file changed since it was read";
 }
 
 }  // namespace

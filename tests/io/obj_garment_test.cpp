@@ -402,6 +402,67 @@ TEST(ObjRead, AFileOfSeveralReadRangesIsReadByteForByte) {
   }
 }
 
+TEST(ObjWrite, AReleasedSourceWritesTheSameBytesReadAgainFromItsFile) {
+  // The resize command drops the file's text after parsing and reads each chunk
+  // again when it writes: the bytes of a kept source, on a file of many chunks
+  // with CRLF lines, normals and colours, and moved positions.
+  std::string text = rich_obj();
+  for (int i = 0; text.size() < 3u * (1u << 18); ++i)
+    text += "v " + std::to_string(i) + " 0.5 -1.25 0.1 0.2 0.3\r\nvn 0 0 1\r\nf -1//-1 -2//-1 -3//-1\r\n";
+  test::TempDir dir;
+  const std::string in = dir.file("in.obj");
+  test::write_text(in, text);
+  const Garment kept = read_garment_obj(in);
+  const Garment released = read_garment_obj(in, SourceText::released);
+  ASSERT_TRUE(released.source->released());
+  EXPECT_EQ(released.source->text.size(), 0u);
+  EXPECT_GT(released.source->chunk_begin.size(), 3u) << "the text must span several chunks";
+  EXPECT_TRUE((released.positions.array() == kept.positions.array()).all());
+  Points moved = kept.positions;
+  moved.col(1).array() += 0.375;
+  moved.col(2) *= std::sqrt(2.0);
+  for (int threads : {1, 2}) {
+    ThreadLimit limit(threads);
+    const std::string a = dir.file("kept.obj"), b = dir.file("released.obj");
+    const ObjWriteReport ra = write_garment_obj(a, kept, moved), rb = write_garment_obj(b, released, moved);
+    EXPECT_TRUE(test::read_text(a) == test::read_text(b)) << threads;
+    EXPECT_EQ(ra.normals_recomputed, rb.normals_recomputed);
+    write_garment_obj(b, released);  // unmoved: the file itself, byte for byte
+    EXPECT_TRUE(test::read_text(b) == text) << threads;
+  }
+}
+
+TEST(ObjWrite, AReleasedSourceWhoseFileChangedIsNotWritten) {
+  const std::string text = strip_obj(20000, true);
+  test::TempDir dir;
+  const std::string in = dir.file("in.obj"), out = dir.file("out.obj");
+  test::write_text(in, text);
+  const Garment g = read_garment_obj(in, SourceText::released);
+  Points moved = g.positions;
+  moved.array() += 0.5;
+  const auto expect_refused = [&](const std::string& changed) {
+    test::write_text(in, changed);
+    try {
+      write_garment_obj(out, g, moved);
+      ADD_FAILURE() << "no error for a changed source";
+    } catch (const Error& e) {
+      EXPECT_THAT(std::string(e.what()), StartsWith(in + ": "));
+      EXPECT_THAT(std::string(e.what()), HasSubstr("changed"));
+    }
+    EXPECT_FALSE(std::filesystem::exists(out));
+    EXPECT_EQ(folder_entries(dir.path()), 1u) << "no temporary file left";
+  };
+  std::string same_size = text;
+  same_size[same_size.size() / 2 + 7] = same_size[same_size.size() / 2 + 7] == '1' ? '2' : '1';  // a digit, late
+  expect_refused(same_size);
+  expect_refused(text + "v 1 2 3\n");  // longer
+  test::write_text(in, text);
+  write_garment_obj(out, g, moved);  // the file as it was read again: written
+  const Garment kept = read_garment_obj(in);
+  write_garment_obj(dir.file("kept.obj"), kept, moved);
+  EXPECT_TRUE(test::read_text(out) == test::read_text(dir.file("kept.obj")));
+}
+
 TEST(ObjRead, ErrorLineIsRightInALaterChunk) {
   const std::string text = strip_obj(12000, true, 20001);
   try {

@@ -317,7 +317,9 @@ int run(ResizeArgs a) {
   }
   progress.stage("reading " + a.garment);
   obj.reset();
-  auto garment = std::make_shared<const Garment>(read_garment_obj(a.garment));
+  // The file's text is read again chunk by chunk when each body is written: kept,
+  // it was the largest single part of a dense garment's peak memory (bench/README.md).
+  auto garment = std::make_shared<const Garment>(read_garment_obj(a.garment, SourceText::released));
   run.load_ms = clock.ms();
   run.garment = garment_summary(*garment);
   run.garment_warnings = garment->source ? garment->source->warnings : std::vector<std::string>{};

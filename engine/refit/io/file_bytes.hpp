@@ -1,6 +1,7 @@
 #pragma once
 // Whole files in and out in parallel ranges: the byte buffer a garment file is
-// read into, and the pread/pwrite loop shared by the reader and the atomic writer.
+// read into, a file read by ranges, and the pread/pwrite loop shared by the
+// readers and the atomic writer.
 #include <sys/types.h>
 
 #include <algorithm>
@@ -31,6 +32,27 @@ class TextBytes {
 /// (pwrite when `write`, else pread), retrying short transfers and EINTR.
 /// Returns 0, the errno of a failure, or -1 when the file ended first.
 int transfer_all(int fd, char* data, std::size_t size, off_t at, bool write);
+
+/// A regular file open for reading by ranges, closed on scope exit. Errors
+/// (refit::Error) name the file.
+class SourceFile {
+ public:
+  explicit SourceFile(const std::string& path);
+  ~SourceFile();
+  SourceFile(const SourceFile&) = delete;
+  SourceFile& operator=(const SourceFile&) = delete;
+  std::size_t size() const { return size_; }
+  int fd() const { return fd_; }
+  /// Bytes [at, at + size) into `out` (resized), several threads reading 8 MB ranges at once.
+  void read(std::size_t at, std::size_t size, std::string& out) const;
+  /// Offset of the first '\n' at or after `at`, or size().
+  std::size_t find_newline(std::size_t at) const;
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+  std::size_t size_ = 0;
+};
 
 /// The whole regular file at `path`, read by several threads in 8 MB ranges (the
 /// kernel's copy and the first touch of the pages were most of a large garment's

@@ -70,7 +70,8 @@ ObjFaceAttributes obj_face_attributes(const Garment& g) {
     return out;
   }
   const ObjSource& src = *g.source;
-  const std::string_view text = src.text.view();
+  TextBytes reread;
+  const std::string_view text = source_text(src, reread);
   const std::vector<std::size_t>& bounds = src.chunk_begin;
   const std::size_t nc = bounds.size() - 1;
   std::vector<ChunkCounts> counts(nc);

@@ -26,7 +26,12 @@ struct ObjSource {
   static constexpr Index kNoNormal = 0xffffffffu;
 
   std::string file;                  // path it was read from (for messages)
-  TextBytes text;                    // the whole file, byte for byte
+  TextBytes text;                    // the whole file, byte for byte (empty when released: see SourceText)
+  std::size_t text_size = 0;         // the file's size in bytes
+  /// With the text released: each chunk's std::hash, taken when it was read, so a
+  /// writer reading the chunk again knows the file is the one parsed.
+  std::vector<std::size_t> chunk_hash;
+  bool released() const { return text.size() == 0 && text_size > 0; }
   std::vector<Span> vertex_spans;    // one per `v` line, in file order
   std::vector<Span> normal_spans;    // one per `vn` line, in file order
   Points positions;                  // the `v` values as read (vertices x 3)
@@ -44,9 +49,23 @@ struct ObjSource {
   std::vector<std::string> warnings;  // e.g. unknown statements kept verbatim
 };
 
+/// What a garment read from a file keeps of the file's text for writing it back.
+enum class SourceText {
+  kept,      // all of it, in memory (its size in bytes: 144 MB for a 1M-vertex garment)
+  released,  // none: a writer reads each chunk again from the file, checked against a
+             // hash of it taken when it was read (a file changed since: an error
+             // naming it, nothing written). The resize command's choice: that memory
+             // was the largest single part of a dense garment's peak.
+};
+
 /// Reads a garment OBJ (see parse_garment_obj). Throws refit::Error when the file
 /// cannot be read or is malformed.
-Garment read_garment_obj(const std::string& path);
+Garment read_garment_obj(const std::string& path, SourceText text = SourceText::kept);
+
+/// The source's text: its own, or, released, the file read again whole into
+/// `store` and checked chunk by chunk. Throws refit::Error naming the file when it
+/// cannot be read or has changed since it was parsed.
+std::string_view source_text(const ObjSource& source, TextBytes& store);
 
 /// Parses OBJ text: `v x y z [w | r g b]`, `vt`, `vn`, `f` (any size >= 3, every
 /// index form v, v/vt, v//vn, v/vt/vn, negative = relative), `l` (>= 2 vertices,

@@ -329,12 +329,22 @@ void fill_csr(Csr& csr, std::vector<Chunk>& chunks, std::vector<Index> Chunk::*s
   });
 }
 
+std::size_t chunk_hash(std::string_view chunk) { return std::hash<std::string_view>{}(chunk); }
+
+std::vector<std::size_t> chunk_hashes(std::string_view text, const std::vector<std::size_t>& bounds) {
+  std::vector<std::size_t> hash(bounds.empty() ? 0 : bounds.size() - 1);
+  parallel_for(0, hash.size(), 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t c = b; c < e; ++c) hash[c] = chunk_hash(text.substr(bounds[c], bounds[c + 1] - bounds[c]));
+  });
+  return hash;
+}
+
 }  // namespace obj_detail
 
 namespace {
 using namespace obj_detail;
 
-Garment parse_owned(TextBytes bytes, const std::string& file) {
+Garment parse_owned(TextBytes bytes, const std::string& file, SourceText keep) {
   const std::string_view text = bytes.view();
   const std::size_t n = text.size();
   auto src = std::make_shared<ObjSource>();
@@ -401,7 +411,12 @@ Garment parse_owned(TextBytes bytes, const std::string& file) {
   const std::size_t first_nl = text.find('\n');
   src->crlf = first_nl != std::string_view::npos && first_nl > 0 && text[first_nl - 1] == '\r';
   chunks.clear();
-  src->text = std::move(bytes);
+  src->text_size = n;
+  if (keep == SourceText::kept) {
+    src->text = std::move(bytes);
+  } else {
+    src->chunk_hash = chunk_hashes(text, bounds);
+  }
   g.source = std::move(src);
   return g;
 }
@@ -409,9 +424,20 @@ Garment parse_owned(TextBytes bytes, const std::string& file) {
 }  // namespace
 
 Garment parse_garment_obj(std::string_view text, const std::string& file_for_errors) {
-  return parse_owned(TextBytes(text), file_for_errors);
+  return parse_owned(TextBytes(text), file_for_errors, SourceText::kept);
 }
 
-Garment read_garment_obj(const std::string& path) { return parse_owned(read_file_bytes(path), path); }
+Garment read_garment_obj(const std::string& path, SourceText text) {
+  return parse_owned(read_file_bytes(path), path, text);
+}
+
+std::string_view source_text(const ObjSource& s, TextBytes& store) {
+  if (!s.released()) return s.text.view();
+  store = read_file_bytes(s.file);
+  const std::string_view text = store.view();
+  if (text.size() != s.text_size || obj_detail::chunk_hashes(text, s.chunk_begin) != s.chunk_hash)
+    throw input_error(s.file, "the file changed while being resized");
+  return text;
+}
 
 }  // namespace refit

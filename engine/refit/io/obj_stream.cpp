@@ -21,61 +21,6 @@ namespace refit {
 namespace {
 using namespace obj_detail;
 
-// A file open for reading by ranges, closed on scope exit.
-class SourceFile {
- public:
-  explicit SourceFile(const std::string& path) : path_(path) {
-    fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd_ < 0) throw input_error(path, std::string("cannot open: ") + std::strerror(errno));
-    struct stat st {};
-    if (::fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode)) {
-      ::close(fd_);
-      throw input_error(path, "cannot read: not a regular file");
-    }
-    size_ = static_cast<std::size_t>(st.st_size);
-  }
-  ~SourceFile() { ::close(fd_); }
-  SourceFile(const SourceFile&) = delete;
-  SourceFile& operator=(const SourceFile&) = delete;
-  std::size_t size() const { return size_; }
-  int fd() const { return fd_; }
-
-  // Bytes [at, at + size) into `out` (resized), several threads reading 8 MB ranges at once.
-  void read(std::size_t at, std::size_t size, std::string& out) const {
-    out.resize(size);
-    constexpr std::size_t kRange = std::size_t(1) << 23;
-    std::atomic<int> error{0};
-    parallel_for(0, (size + kRange - 1) / kRange, 1, [&](std::size_t b, std::size_t e) {
-      for (std::size_t r = b; r < e && error.load() == 0; ++r) {
-        const std::size_t off = r * kRange;
-        const int failed = transfer_all(fd_, out.data() + off, std::min(kRange, size - off), off_t(at + off), false);
-        int expected = 0;
-        if (failed != 0) error.compare_exchange_strong(expected, failed);
-      }
-    });
-    if (error.load() > 0) throw input_error(path_, std::string("cannot read: ") + std::strerror(error.load()));
-    if (error.load() < 0) throw input_error(path_, "cannot read the whole file (it got shorter while being read)");
-  }
-
-  // Offset of the first '\n' at or after `at`, or size().
-  std::size_t find_newline(std::size_t at) const {
-    char buf[4096];
-    while (at < size_) {
-      const std::size_t n = std::min(sizeof buf, size_ - at);
-      const int failed = transfer_all(fd_, buf, n, off_t(at), false);
-      if (failed != 0) throw input_error(path_, "cannot read the whole file");
-      if (const void* nl = std::memchr(buf, '\n', n)) return at + std::size_t(static_cast<const char*>(nl) - buf);
-      at += n;
-    }
-    return size_;
-  }
-
- private:
-  std::string path_;
-  int fd_ = -1;
-  std::size_t size_ = 0;
-};
-
 bool same_bits(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); }
 
 }  // namespace

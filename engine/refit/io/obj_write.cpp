@@ -172,21 +172,39 @@ Parts format_source(const Garment& g, const Points& x, const ObjSource& s, ObjWr
     Points normals;
   };
   auto edits = std::make_shared<Edits>(Edits{std::move(moved), std::move(recomputed), std::move(normals)});
-  return {s.chunk_begin.size() - 1, [&x, &s, edits](std::size_t c, std::string& out) {
+  // A released source is read again a chunk at a time (buffers the writer
+  // reuses, not the whole file in fresh memory), each checked against its hash.
+  std::shared_ptr<const SourceFile> file;
+  if (s.released()) {
+    file = std::make_shared<const SourceFile>(s.file);
+    if (file->size() != s.text_size) throw input_error(s.file, "the file changed while being resized; nothing written");
+  }
+  return {s.chunk_begin.size() - 1, [&x, &s, edits, file](std::size_t c, std::string& out) {
             const std::size_t pos = s.chunk_begin[c], end = s.chunk_begin[c + 1];
+            std::string chunk;
+            std::string_view text = s.text.view();
+            std::size_t base = 0;  // where `text` starts in the file
+            if (file) {
+              file->read(pos, end - pos, chunk);
+              if (obj_detail::chunk_hash(chunk) != s.chunk_hash[c])
+                throw input_error(s.file, "the file changed while being resized; nothing written");
+              text = chunk;
+              base = pos;
+            }
             out.reserve(end - pos + (end - pos) / 4);
             struct {
               const ObjSource& s;
               const Points& x;
               const Edits& e;
-              ObjSource::Span vertex_span(std::size_t i) const { return s.vertex_spans[i]; }
-              ObjSource::Span normal_span(std::size_t i) const { return s.normal_spans[i]; }
+              std::size_t base;
+              ObjSource::Span vertex_span(std::size_t i) const { return {s.vertex_spans[i].begin - base, s.vertex_spans[i].end - base}; }
+              ObjSource::Span normal_span(std::size_t i) const { return {s.normal_spans[i].begin - base, s.normal_spans[i].end - base}; }
               bool moved(std::size_t i) const { return e.moved[i]; }
               bool recomputed(std::size_t i) const { return !e.recomputed.empty() && e.recomputed[i]; }
               Vec3 position(std::size_t i) const { return row3(x, Index(i)); }
               Vec3 normal(std::size_t i) const { return row3(e.normals, Index(i)); }
-            } edit{s, x, *edits};
-            obj_detail::splice_chunk(s.text.view(), pos, end, s.chunk_first_vertex[c], s.chunk_first_vertex[c + 1],
+            } edit{s, x, *edits, base};
+            obj_detail::splice_chunk(text, pos - base, end - base, s.chunk_first_vertex[c], s.chunk_first_vertex[c + 1],
                                      s.chunk_first_normal[c], s.chunk_first_normal[c + 1], edit, out);
           }};
 }
