@@ -52,6 +52,21 @@ def test_resize_equals_the_command_line(demo, tmp_path):
     assert (tmp_path / "py.obj").read_bytes() == out.read_bytes()
 
 
+def test_a_garment_read_without_its_text_writes_the_same_file(demo, tmp_path):
+    source = tmp_path / "dress.obj"
+    source.write_bytes((demo / "dress.obj").read_bytes())
+    kept, released = refit.read_garment(str(source)), refit.read_garment(str(source), keep_text=False)
+    moved = np.array(kept.positions) + [0.0, 0.5, 0.25]
+    refit.write_garment(kept, moved, str(tmp_path / "kept.obj"))
+    refit.write_garment(released, moved, str(tmp_path / "released.obj"))
+    assert (tmp_path / "kept.obj").read_bytes() == (tmp_path / "released.obj").read_bytes()
+    with open(source, "a") as f:
+        f.write("# edited\n")
+    with pytest.raises(refit.InputError, match="changed"):
+        refit.write_garment(released, moved, str(tmp_path / "after.obj"))
+    assert not (tmp_path / "after.obj").exists()
+
+
 def test_body_b_as_an_array(demo):
     g = refit.read_garment(str(demo / "dress.obj"))
     a = refit.read_body(str(demo / "A.obj"))

@@ -270,11 +270,14 @@ PYBIND11_MODULE(_refit, m) {
 
   m.def(
       "read_garment",
-      [](const std::string& path) {
+      [](const std::string& path, bool keep_text) {
         py::gil_scoped_release unlocked;
-        return std::make_shared<Garment>(read_garment_obj(path));
+        return std::make_shared<Garment>(read_garment_obj(path, keep_text ? SourceText::kept : SourceText::released));
       },
-      py::arg("path"), "Reads a garment OBJ (every line kept for write_garment). InputError naming file and line.");
+      py::arg("path"), py::arg("keep_text") = true,
+      "Reads a garment OBJ (every line kept for write_garment). InputError naming file and line. keep_text=False: "
+      "the file's text is not held in memory (144 MB for a 1M-vertex garment) but read again by write_garment, "
+      "which raises InputError if the file changed in between.");
   m.def(
       "write_garment",
       [](const Garment& g, const py::array_t<double, py::array::forcecast>& positions, const std::string& path) {

@@ -114,7 +114,7 @@ def _bound(job):
         if job in _bindings:
             return _bindings[job] + (None,)
         start = time.perf_counter()
-        garment = refit.read_garment(job.garment)
+        garment = refit.read_garment(job.garment, keep_text=False)  # write_garment reads the file again
         features = refit.read_features(job.features, units=job.units) if job.features else None
         binding = refit.Binding(garment, refit.read_body(job.body_a), features=features, units=job.units,
                                 stage=job.stage, symmetry=job.symmetry, collision=job.collision,
