@@ -109,10 +109,12 @@ void splice_chunk(std::string_view text, std::size_t pos, std::size_t end, std::
   out.append(text.substr(pos, end - pos));
 }
 
-/// A chunk's hash (std::hash of its bytes), and every chunk's of `text` split at
-/// `bounds`: how a writer that reads a released source again knows it unchanged.
-std::size_t chunk_hash(std::string_view chunk);
+/// Every chunk's hash (std::hash of its bytes) of `text` split at `bounds`, kept by
+/// a released source; check_reread throws refit::Error naming the source's file
+/// ("... changed while being resized; nothing written") when chunk `c` read
+/// again differs.
 std::vector<std::size_t> chunk_hashes(std::string_view text, const std::vector<std::size_t>& bounds);
+void check_reread(const ObjSource& s, std::size_t c, std::string_view chunk);
 
 /// The rows of the chunks' `sizes` and `indices` (pass 2) as one CSR, in chunk order.
 void fill_csr(Csr& csr, std::vector<Chunk>& chunks, std::vector<Index> Chunk::*sizes, std::vector<Index> Chunk::*indices);

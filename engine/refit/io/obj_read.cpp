@@ -329,14 +329,18 @@ void fill_csr(Csr& csr, std::vector<Chunk>& chunks, std::vector<Index> Chunk::*s
   });
 }
 
-std::size_t chunk_hash(std::string_view chunk) { return std::hash<std::string_view>{}(chunk); }
-
 std::vector<std::size_t> chunk_hashes(std::string_view text, const std::vector<std::size_t>& bounds) {
   std::vector<std::size_t> hash(bounds.empty() ? 0 : bounds.size() - 1);
   parallel_for(0, hash.size(), 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t c = b; c < e; ++c) hash[c] = chunk_hash(text.substr(bounds[c], bounds[c + 1] - bounds[c]));
+    for (std::size_t c = b; c < e; ++c)
+      hash[c] = std::hash<std::string_view>{}(text.substr(bounds[c], bounds[c + 1] - bounds[c]));
   });
   return hash;
+}
+
+void check_reread(const ObjSource& s, std::size_t c, std::string_view chunk) {
+  if (chunk.size() != s.chunk_begin[c + 1] - s.chunk_begin[c] || std::hash<std::string_view>{}(chunk) != s.chunk_hash[c])
+    throw input_error(s.file, "the file changed while being resized; nothing written");
 }
 
 }  // namespace obj_detail
@@ -435,8 +439,11 @@ std::string_view source_text(const ObjSource& s, TextBytes& store) {
   if (!s.released()) return s.text.view();
   store = read_file_bytes(s.file);
   const std::string_view text = store.view();
-  if (text.size() != s.text_size || obj_detail::chunk_hashes(text, s.chunk_begin) != s.chunk_hash)
-    throw input_error(s.file, "the file changed while being resized");
+  if (text.size() != s.text_size) throw input_error(s.file, "the file changed while being resized; nothing written");
+  parallel_for(0, s.chunk_hash.size(), 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t c = b; c < e; ++c)
+      obj_detail::check_reread(s, c, text.substr(s.chunk_begin[c], s.chunk_begin[c + 1] - s.chunk_begin[c]));
+  });
   return text;
 }
 

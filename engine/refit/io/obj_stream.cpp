@@ -10,12 +10,7 @@
 #include <refit/io/obj_detail.hpp>
 
 #include <bit>
-#include <cerrno>
 #include <cmath>
-#include <cstring>
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 namespace refit {
 namespace {

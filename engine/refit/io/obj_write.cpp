@@ -186,8 +186,7 @@ Parts format_source(const Garment& g, const Points& x, const ObjSource& s, ObjWr
             std::size_t base = 0;  // where `text` starts in the file
             if (file) {
               file->read(pos, end - pos, chunk);
-              if (obj_detail::chunk_hash(chunk) != s.chunk_hash[c])
-                throw input_error(s.file, "the file changed while being resized; nothing written");
+              obj_detail::check_reread(s, c, chunk);
               text = chunk;
               base = pos;
             }
