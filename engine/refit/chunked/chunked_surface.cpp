@@ -163,8 +163,7 @@ std::vector<std::uint32_t> chunked_layers(const GarmentStore& g, const PointGath
     for (std::size_t i = 0; i < boundary.size(); ++i) unite_roots(parent, boundary[i], boundary[near[i]]);
     area = piece_area();
   }
-  // Roots first (parents point to smaller vertices), then each vertex's label in place.
-  for (Index v = 0; v < n; ++v) parent[v] = parent[parent[v]];
+  flatten_roots(parent);  // then each vertex's label in place
   std::unordered_map<Index, std::uint32_t> of_root;
   std::uint32_t next = 1;
   std::vector<std::uint32_t>& label = parent;  // the same memory, vertex by vertex

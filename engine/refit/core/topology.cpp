@@ -3,6 +3,7 @@
 #include <refit/core/error.hpp>
 
 #include <refit/core/parallel.hpp>
+#include <refit/core/union_find.hpp>
 
 #include <algorithm>
 
@@ -101,23 +102,6 @@ void for_each_edge(const FaceEdges& e, F&& f) {
     }
 }
 
-struct UnionFind {
-  std::vector<Index> parent;
-  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), Index(0)); }
-  Index find(Index x) {
-    while (parent[x] != x) {
-      parent[x] = parent[parent[x]];
-      x = parent[x];
-    }
-    return x;
-  }
-  void unite(Index a, Index b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  }
-};
-
 std::vector<std::vector<Index>> loops_from_edges(const Garment& g, const FaceEdges& edges);
 
 }  // namespace
@@ -137,21 +121,22 @@ TopologyStats topology_stats(const Garment& g) {
     if (k >= 3) ++s.non_manifold_edges;
   });
 
-  UnionFind uf(s.vertices);
+  std::vector<Index> parent(s.vertices);
+  std::iota(parent.begin(), parent.end(), Index{0});
   std::vector<std::uint8_t> used(s.vertices, 0);
   for (const Csr* csr : {&g.faces, &g.lines})
     for (std::size_t r = 0; r < csr->rows(); ++r) {
       const auto row = csr->row(r);
       for (Index v : row) {
         used[v] = 1;
-        uf.unite(row[0], v);
+        unite_roots(parent, row[0], v);
       }
     }
   // `p v1 v2 ...` lists separate points (OBJ spec): each vertex stands alone.
   for (Index v : g.points.indices) used[v] = 1;
   for (std::size_t v = 0; v < s.vertices; ++v) {
     if (!used[v]) ++s.unreferenced_vertices;
-    else if (uf.find(static_cast<Index>(v)) == v) ++s.components;
+    else if (parent[v] == v) ++s.components;  // a root
   }
   s.boundary_loops = loops_from_edges(g, edges).size();
   return s;

@@ -1,6 +1,6 @@
 #pragma once
 // Union-find over a parent vector (parent[i] == i for a root; start with
-// std::iota), with path halving. Used to group garment vertices into layers.
+// std::iota), with path halving. Groups garment vertices into layers and pieces.
 // Not thread-safe: find_root shortens paths as it walks.
 
 #include <algorithm>
@@ -21,6 +21,13 @@ inline void unite_roots(std::vector<Index>& parent, Index a, Index b) {
   a = find_root(parent, a);
   b = find_root(parent, b);
   if (a != b) parent[std::max(a, b)] = std::min(a, b);
+}
+
+/// Every entry pointed at its root, in one pass: a parent is never larger than
+/// its child (unite_roots keeps the smaller root, find_root only skips to
+/// ancestors), so a vertex's parent is flat before the vertex.
+inline void flatten_roots(std::vector<Index>& parent) {
+  for (Index& p : parent) p = parent[p];
 }
 
 }  // namespace refit
