@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 
 namespace refit {
@@ -50,6 +51,25 @@ TEST(Clearance, HoldClearOfBodyLiftsFreeAgentsCloserThanTheClearance) {
   EXPECT_NEAR(x(1, 1), 0.4, 1e-6);
   EXPECT_DOUBLE_EQ(x(2, 1), 0.6);
   EXPECT_EQ(fixed, (std::vector<std::uint8_t>{3, 3, 0}));
+}
+
+// Where the distance grows slower than linearly (a point in a crease of the
+// body), Newton's steps approach the clearance from below and their last one
+// ended a rounding error short of it; clear_point then went back towards
+// `fallback` (an agent's warped place, which can itself be too close: the
+// shared skirt on F_thinner had an agent moved 0.8 cm, into the clearance).
+TEST(Clearance, ClearPointLandsOnTheClearanceNotOnTheFallback) {
+  const std::function<double(const Vec3&)> crease = [](const Vec3& p) { return 2.0 * (std::sqrt(p.y() + 1.0) - 1.0); };
+  const double clearance = 0.4, step = 1e-4;
+  const Vec3 fallback(0.0, 0.05, 0.0);  // too close as well
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 start(0.01 * i, -0.5 + 0.0047 * i, 0.3);
+    const Vec3 q = clear_point(crease, clearance, step, start, fallback);
+    EXPECT_GE(crease(q), clearance) << i;
+    EXPECT_LT(crease(q), clearance + 1e-3 * step) << i;
+    EXPECT_EQ(q.x(), start.x()) << i;  // along the gradient only
+    EXPECT_EQ(q.z(), start.z()) << i;
+  }
 }
 
 }  // namespace

@@ -15,9 +15,16 @@ namespace {
 Vec3 point_at_distance(const std::function<double(const Vec3&)>& distance, double target, bool above, double step,
                        Vec3 p, const Vec3& fallback) {
   const auto on_side = [&](double d) { return above ? d >= target : d <= target; };
+  // The steps aim at the middle of the band they accept, not at its edge: where
+  // the distance grows slower than linearly (in a crease of the body) they
+  // approach the target from one side and ended a rounding error short of it,
+  // and then the fallback below took over (an agent of the shared skirt on
+  // F_thinner went to its warped place, 0.8 cm away and inside the clearance,
+  // or not, as the solve's tolerance went from 1e-8 to 1e-10).
+  const double band = 1e-3 * step, aim = above ? target + 0.5 * band : target - 0.5 * band;
   for (int k = 0; k < 4; ++k) {
     const double d = distance(p);
-    if (on_side(d) && (above ? d < target + 1e-3 * step : d > target - 1e-3 * step)) return p;
+    if (on_side(d) && (above ? d < target + band : d > target - band)) return p;
     Vec3 g;
     for (int i = 0; i < 3; ++i) {
       Vec3 e = Vec3::Zero();
@@ -25,7 +32,7 @@ Vec3 point_at_distance(const std::function<double(const Vec3&)>& distance, doubl
       g[i] = (distance(p + e) - distance(p - e)) / (2.0 * step);
     }
     if (!(g.squaredNorm() > 0.25)) break;
-    p += ((target - d) / g.squaredNorm()) * g;
+    p += ((aim - d) / g.squaredNorm()) * g;
   }
   if (on_side(distance(p))) return p;
   double lo = 0.0, hi = 1.0;
