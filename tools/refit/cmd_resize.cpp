@@ -427,10 +427,10 @@ const Register reg("resize", "Resize a garment from body A to one or many bodies
       ->group(kAdvanced);
   app.add_option("--max-iterations", a->surface.max_iterations, "Gauss-Seidel iterations, at most")->capture_default_str()
       ->group(kAdvanced);
-  app.add_option("--tolerance", a->surface.tolerance, "Gauss-Seidel stops below this update norm")->capture_default_str()
+  app.add_option("--tolerance", a->surface.tolerance, "Gauss-Seidel stops below this update norm (cm)")->capture_default_str()
       ->group(kAdvanced);
   app.add_option("--tolerance-rms", a->surface.tolerance_rms,
-                 "If positive: stop when the update's RMS per free agent is below this (instead of --tolerance on its L2 norm)")
+                 "If positive: stop when the update's RMS per free agent is below this (cm; instead of --tolerance on its L2 norm)")
       ->capture_default_str()
       ->group(kAdvanced);
   app.add_flag("--plain-sweeps", a->plain_sweeps,

@@ -61,6 +61,11 @@ SurfaceOptions surface_options_in_units(const ResizeOptions& options) {
   so.voxel *= per_cm;
   so.feature_bend_radius *= per_cm;
   so.near_body_band *= per_cm;
+  // The solve stops on the size of its update, a length too: in mm it went on
+  // 10 times longer than in cm and came out elsewhere (the skirt on F_thinner:
+  // 0.5 cm apart).
+  so.tolerance *= per_cm;
+  so.tolerance_rms *= per_cm;
   so.clearance = 2.0 * options.clearance_cm * per_cm;
   return so;
 }
