@@ -65,9 +65,10 @@ TEST(Units, AGarmentInMillimetresResizesAsInCentimetres) {
 
 // The shared skirt and dress, resized in mm against in cm. Measured: the skirt
 // 0.00015 cm apart at most (0.51 cm before, 0.09 with the stop rule alone); the
-// dress 0.03 cm at the 99th percentile and 0.13 at most, as before: 2 of its
-// vertices lie on eq. 14's threshold (without the collision step the 99th
-// percentile is 4e-8 cm) and the collision step's rounds carry that further.
+// dress 0.03 cm at the 99th percentile and 0.13 at most, as before: the voxel
+// sampling picks another sample for one agent near the centre back in mm, so a
+// vertex on the mirror plane has another nearest agent and eq. 14 keeps it in
+// one run only (without the collision step the 99th percentile is 4e-8 cm).
 TEST(Units, SharedGarmentsInMillimetresResizeAsInCentimetres) {
   const std::string data = test::shared_data_dir();
   if (data.empty()) GTEST_SKIP() << "../shared/data is absent: real-data units test skipped";
