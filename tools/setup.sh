@@ -45,17 +45,15 @@ case "${1:-build}" in
     ;;
   test)
     ctest --preset release -j "$jobs"
-    # The same suite under AddressSanitizer and UBSan, then each libFuzzer target
-    # for 30 s (tests/fuzz/; bench/fuzz.sh runs them longer). The sanitize preset
-    # leaves out three large cases (CMakePresets.json: 230 of its 640 test-seconds,
-    # brute-force scans and a 100k-agent solve whose code the smaller cases run
-    # too); the release pass runs them.
+    # The same suite under AddressSanitizer and UBSan, built by clang with
+    # libFuzzer's coverage so that the same build also runs each fuzz target for
+    # 30 s (tests/fuzz/; bench/fuzz.sh runs them longer): one build less than a
+    # separate fuzz tree. The sanitize preset leaves out three large cases
+    # (CMakePresets.json: 230 of its 640 test-seconds, brute-force scans and a
+    # 100k-agent solve whose code the smaller cases run too); the release pass runs them.
     cmake --preset sanitize >/dev/null
     cmake --build --preset sanitize -j "$jobs"
     ctest --preset sanitize -j "$jobs"
-    cmake --preset fuzz >/dev/null
-    cmake --build --preset fuzz -j "$jobs"
-    ctest --preset fuzz -j "$jobs"
     ;;
   *) echo "usage: tools/setup.sh [build|demo [DIR]|test]" >&2; exit 2 ;;
 esac
