@@ -46,9 +46,10 @@ case "${1:-build}" in
   test)
     ctest --preset release -j "$jobs"
     # The same suite under AddressSanitizer and UBSan, built by clang with
-    # libFuzzer's coverage so that the same build also runs each fuzz target for
-    # 30 s (tests/fuzz/; bench/fuzz.sh runs them longer): one build less than a
-    # separate fuzz tree. The sanitize preset leaves out three large cases
+    # libFuzzer's edge coverage in the engine (not in the tests) so that the same
+    # build also runs each fuzz target for 30 s (tests/fuzz/; bench/fuzz.sh runs
+    # them longer, with comparison tracing too): one build less than a separate
+    # fuzz tree. The sanitize preset leaves out three large cases
     # (CMakePresets.json: 230 of its 640 test-seconds, brute-force scans and a
     # 100k-agent solve whose code the smaller cases run too); the release pass runs them.
     cmake --preset sanitize >/dev/null
