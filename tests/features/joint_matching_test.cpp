@@ -7,6 +7,8 @@
 #include <refit/features/shape_matching.hpp>
 #include <refit/features/symmetry.hpp>
 
+#include "deformations.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -20,16 +22,8 @@ using namespace refit;
 
 namespace {
 
-// A smooth, non-similar deformation: what a warp around a changed body does.
-Vec3 bend(const Vec3& p) {
-  return Vec3(p.x() + 0.05 * p.y() * p.y(), p.y() + 0.8 * std::sin(0.3 * p.x()), p.z() + 0.02 * p.x() * p.x());
-}
-
-Points map_rows(const Points& p, const std::function<Vec3(const Vec3&)>& f) {
-  Points out(p.rows(), 3);
-  for (Eigen::Index i = 0; i < p.rows(); ++i) out.row(i) = f(row3(p, Index(i))).transpose();
-  return out;
-}
+using test::bend;
+using test::map_rows;
 
 double to_body(const Vec3& p) { return std::abs(p.y() + 12.0) + 0.1 * std::abs(p.x()); }
 

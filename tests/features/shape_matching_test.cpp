@@ -5,6 +5,8 @@
 #include <refit/features/curve_metrics.hpp>
 #include <refit/features/shape_matching.hpp>
 
+#include "deformations.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -22,16 +24,8 @@ Points zigzag(std::size_t m, int teeth, double width, double height) {
   return resample_polyline(corners, m, false);
 }
 
-// A smooth, non-similar deformation: what a warp around a changed body does.
-Vec3 bend(const Vec3& p) {
-  return Vec3(p.x() + 0.05 * p.y() * p.y(), p.y() + 0.8 * std::sin(0.3 * p.x()), p.z() + 0.02 * p.x() * p.x());
-}
-
-Points map_rows(const Points& p, Vec3 (*f)(const Vec3&)) {
-  Points out(p.rows(), 3);
-  for (Eigen::Index i = 0; i < p.rows(); ++i) out.row(i) = f(row3(p, static_cast<Index>(i))).transpose();
-  return out;
-}
+using test::bend;
+using test::map_rows;
 
 FeaturePlane plane_z0() { return FeaturePlane::from_point_normal(Vec3::Zero(), Vec3::UnitZ()); }
 

@@ -11,7 +11,7 @@
 namespace refit {
 namespace {
 
-constexpr int kN = 21;          // vertices per side, spacing 1, on y = 0
+constexpr int kGridSide = 21;          // vertices per side, spacing 1, on y = 0
 constexpr double kReach = 2.5;  // a vertex blends the samples within this distance
 
 struct Sheet {
@@ -26,13 +26,13 @@ struct Sheet {
 Sheet sheet() {
   Sheet s;
   Garment& g = s.garment;
-  g.positions.resize(kN * kN, 3);
-  for (int i = 0; i < kN; ++i)
-    for (int k = 0; k < kN; ++k) g.positions.row(i * kN + k) << i, 0.0, k;
-  for (int i = 0; i + 1 < kN; ++i)
-    for (int k = 0; k + 1 < kN; ++k) {
-      const Index a = Index(i * kN + k);
-      const std::array<Index, 4> q{a, a + 1, a + 1 + Index(kN), a + Index(kN)};
+  g.positions.resize(kGridSide * kGridSide, 3);
+  for (int i = 0; i < kGridSide; ++i)
+    for (int k = 0; k < kGridSide; ++k) g.positions.row(i * kGridSide + k) << i, 0.0, k;
+  for (int i = 0; i + 1 < kGridSide; ++i)
+    for (int k = 0; k + 1 < kGridSide; ++k) {
+      const Index a = Index(i * kGridSide + k);
+      const std::array<Index, 4> q{a, a + 1, a + 1 + Index(kGridSide), a + Index(kGridSide)};
       g.faces.push_row(q);
     }
   const int m = 33;
@@ -90,7 +90,7 @@ TEST(FeatureSnap, TheCarriedSamplesReachTheirTargetsAndOnlyNearbyVerticesMove) {
   EXPECT_GT(moved, 0u);
   // Smooth and bounded: the correction fades away from the curve (rows z = 10, 11
   // carry the samples) to nothing at z = 14, and overshoots the targets nowhere.
-  auto lift = [&](int i, int k) { return std::abs(p(i * kN + k, 1)); };
+  auto lift = [&](int i, int k) { return std::abs(p(i * kGridSide + k, 1)); };
   EXPECT_GT(lift(10, 12), 0.0);
   EXPECT_LT(lift(10, 13), lift(10, 12));
   EXPECT_EQ(lift(10, 14), 0.0);
@@ -101,7 +101,7 @@ TEST(FeatureSnap, HeldVerticesStayAndTheSamplesOnThemStayToo) {
   const Sheet s = sheet();
   std::vector<std::uint8_t> held(s.garment.vertex_count(), 0);
   for (int i = 0; i <= 6; ++i)
-    for (int k = 0; k < kN; ++k) held[i * kN + k] = 1;  // x <= 6
+    for (int k = 0; k < kGridSide; ++k) held[i * kGridSide + k] = 1;  // x <= 6
   Points p = s.garment.positions;
   const Points targets = lifted(s.samples);
   const FeatureSnapReport rep = snap_to_features(p, targets, s.at, s.reach, s.weight, s.feature_of, held, 1e-3);

@@ -18,13 +18,12 @@ namespace {
 Garment sheet(int n, double s, double y0, double x0 = 0.0, double z0 = 0.0, double wave = 0.0) {
   return test::quad_grid(n, n, s, [=](double x, double) { return y0 + wave * std::sin(1.7 * x); }, x0, z0);
 }
-Garment merge(const Garment& a, const Garment& b) { return test::merge_garments(a, b); }
 
 std::uint32_t max_layer(const std::vector<std::uint32_t>& l) { return *std::max_element(l.begin(), l.end()); }
 
 TEST(GarmentLayers, PiecesOverEachOtherAreLayersSeamsAndSoupsAreNot) {
   // Two sheets 0.4 apart: two layers, each one label throughout.
-  const Garment two = merge(sheet(11, 1.0, 0.0), sheet(11, 1.0, 0.4));
+  const Garment two = test::merge_garments(sheet(11, 1.0, 0.0), sheet(11, 1.0, 0.4));
   const std::vector<std::uint32_t> l2 = garment_layers(two, 8.0, 0.1);
   ASSERT_EQ(l2.size(), two.vertex_count());
   EXPECT_EQ(max_layer(l2), 2u);
@@ -32,14 +31,14 @@ TEST(GarmentLayers, PiecesOverEachOtherAreLayersSeamsAndSoupsAreNot) {
   for (std::size_t v = 121; v < 242; ++v) EXPECT_EQ(l2[v], 2u);
 
   // Two panels side by side sharing coincident but separate seam vertices (x = 10): one layer.
-  const Garment seam = merge(sheet(11, 1.0, 0.0), sheet(11, 1.0, 0.0, 10.0));
+  const Garment seam = test::merge_garments(sheet(11, 1.0, 0.0), sheet(11, 1.0, 0.0, 10.0));
   EXPECT_EQ(max_layer(garment_layers(seam, 8.0, 0.1)), 1u);
   // Cut apart by a gap of 0.05: one layer when boundaries within 0.1 join, two when nothing joins.
-  const Garment gap = merge(sheet(11, 1.0, 0.0), sheet(11, 1.0, 0.0, 10.05));
+  const Garment gap = test::merge_garments(sheet(11, 1.0, 0.0), sheet(11, 1.0, 0.0, 10.05));
   EXPECT_EQ(max_layer(garment_layers(gap, 8.0, 0.1)), 1u);
   EXPECT_EQ(max_layer(garment_layers(gap, 8.0, 0.0)), 2u);
   // A gap of 0.3 is no seam.
-  EXPECT_EQ(max_layer(garment_layers(merge(sheet(11, 1.0, 0.0), sheet(11, 1.0, 0.0, 10.3)), 8.0, 0.1)), 2u);
+  EXPECT_EQ(max_layer(garment_layers(test::merge_garments(sheet(11, 1.0, 0.0), sheet(11, 1.0, 0.0, 10.3)), 8.0, 0.1)), 2u);
 
   // Points, hanging lines and small pieces are loose (0): they belong to no layer.
   Garment extras = sheet(3, 0.5, 5.0);  // area 1: below the 8 of a layer
@@ -47,7 +46,7 @@ TEST(GarmentLayers, PiecesOverEachOtherAreLayersSeamsAndSoupsAreNot) {
   extras.positions.bottomRows(3) << 20, 0, 0, 21, 0, 0, 22, 0, 0;
   extras.lines.push_row(std::array<Index, 2>{9, 10});
   extras.points.push_row(std::array<Index, 1>{11});
-  const Garment with_extras = merge(sheet(11, 1.0, 0.0), extras);
+  const Garment with_extras = test::merge_garments(sheet(11, 1.0, 0.0), extras);
   const std::vector<std::uint32_t> le = garment_layers(with_extras, 8.0, 0.1);
   EXPECT_EQ(max_layer(le), 1u);
   for (std::size_t v = 121; v < with_extras.vertex_count(); ++v) EXPECT_EQ(le[v], 0u) << v;
@@ -56,7 +55,7 @@ TEST(GarmentLayers, PiecesOverEachOtherAreLayersSeamsAndSoupsAreNot) {
 TEST(GarmentLayers, EachLayerGetsItsOwnAgentsAndRings) {
   // Sheets 0.3 voxel apart: the paper's one agent per voxel leaves about half
   // the voxels of each sheet to the other; with layers every voxel of each has one.
-  const Garment g = merge(sheet(21, 0.5, 0.0), sheet(21, 0.5, 0.3));
+  const Garment g = test::merge_garments(sheet(21, 0.5, 0.0), sheet(21, 0.5, 0.3));
   const VoxelGrid grid = make_voxel_grid(g, Points(0, 3), 1.0);
   const std::vector<std::uint32_t> layer = garment_layers(g, 8.0, 0.1);
   const GarmentAgents shared = select_agents(g, grid);
@@ -87,7 +86,7 @@ double bump_at(double x, double z) { return 0.6 * std::exp(-0.25 * (std::pow(x -
 // Lower sheet at y = 0, upper at y = 0.4, both wavy (so that without layers
 // the voxels' agents fall on either); the warp puts body B's bump into both.
 struct TwoSheets {
-  Garment g = merge(sheet(17, 0.5, 0.0, 0.0, 0.0, 0.3), sheet(17, 0.5, 0.4, 0.0, 0.0, 0.3));
+  Garment g = test::merge_garments(sheet(17, 0.5, 0.0, 0.0, 0.0, 0.3), sheet(17, 0.5, 0.4, 0.0, 0.0, 0.3));
   Points warped = g.positions;
   TwoSheets() {
     for (Eigen::Index v = 0; v < warped.rows(); ++v) warped(v, 1) += bump_at(warped(v, 0), warped(v, 2));

@@ -24,7 +24,6 @@ Garment patch(int nx, int nz, double s, H&& height, double x0 = 0.0, double z0 =
 Garment flat_patch(int n, double s, double x0 = 0.0, double z0 = 0.0) {
   return patch(n, n, s, [](double, double) { return 0.0; }, x0, z0);
 }
-Garment merge(const Garment& a, const Garment& b) { return test::merge_garments(a, b); }
 
 // Points on a sphere (Fibonacci spiral).
 Points sphere_points(int n, double radius) {
@@ -335,7 +334,7 @@ TEST(SurfaceBindingTest, IsolatedPieceIsAnchoredAndDoesNotDrift) {
   // Piece 1 touches the body; piece 2 floats far from body and features.
   const Garment near = flat_patch(15, 0.5);
   const Garment far = flat_patch(6, 0.5, 100.0, 100.0);
-  Garment g = merge(near, far);
+  Garment g = test::merge_garments(near, far);
   Points warped = g.positions;
   for (Eigen::Index v = 0; v < warped.rows(); ++v) warped(v, 1) += 0.1 * std::sin(warped(v, 0));
   SurfaceOptions o;

@@ -63,7 +63,7 @@ int run(const CompareArgs& a) {
   return 0;
 }
 
-const Register reg("compare", "score a resize result (any tool's, same vertex order) against the garment and bodies",
+const Register compare_command("compare", "score a resize result (any tool's, same vertex order) against the garment and bodies",
                    [](CLI::App& app) -> std::function<int()> {
                      auto args = std::make_shared<CompareArgs>();
                      app.add_option("--garment", args->garment, "garment OBJ on body A")->required();

@@ -118,7 +118,7 @@ int run(const DemoArgs& a) {
   return 0;
 }
 
-const Register reg("demo", "Generate the built-in example (mannequin pair and dress), resize it and write everything",
+const Register demo_command("demo", "Generate the built-in example (mannequin pair and dress), resize it and write everything",
                    [](CLI::App& app) {
                      auto a = std::make_shared<DemoArgs>();
                      app.add_option("--out-dir", a->out_dir, "Output folder")->capture_default_str();

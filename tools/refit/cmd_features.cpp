@@ -20,7 +20,7 @@ struct FeaturesOptions {
   std::string garment, features, out, units = "cm";
 };
 
-const refit::cli::Register reg(
+const refit::cli::Register features_command(
     "features", "Sample the feature curves of a feature file on a garment and write them as OBJ polylines",
     [](CLI::App& app) {
       auto opt = std::make_shared<FeaturesOptions>();

@@ -75,7 +75,7 @@ int run(const FlattenArgs& a) {
   return 0;
 }
 
-const Register reg("flatten", "Flatten a garment into 2D pattern pieces: SVG, DXF and a JSON report", [](CLI::App& app) {
+const Register flatten_command("flatten", "Flatten a garment into 2D pattern pieces: SVG, DXF and a JSON report", [](CLI::App& app) {
   auto a = std::make_shared<FlattenArgs>();
   app.add_option("--garment", a->garment, "Garment OBJ to flatten")->required();
   app.add_option("--out-dir", a->out.dir, "Output folder: NAME.svg, NAME.dxf, NAME.json (NAME-grading.svg)")->required();

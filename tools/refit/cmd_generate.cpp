@@ -51,7 +51,7 @@ int run(const GenerateArgs& a) {
   return 0;
 }
 
-const Register reg("generate", "Write a procedural mannequin, garment and feature file", [](CLI::App& app) {
+const Register generate_command("generate", "Write a procedural mannequin, garment and feature file", [](CLI::App& app) {
   auto a = std::make_shared<GenerateArgs>();
   add_body_options(app, a->body);
   app.add_option("--resolution", a->body.resolution, "Body resolution (1: about 26k triangles)")->capture_default_str();

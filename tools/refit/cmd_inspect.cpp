@@ -27,7 +27,7 @@ struct InspectOptions {
   bool json = false;
 };
 
-const refit::cli::Register reg(
+const refit::cli::Register inspect_command(
     "inspect", "Print the element counts and topology of a garment OBJ", [](CLI::App& app) {
       auto opt = std::make_shared<InspectOptions>();
       app.add_option("file", opt->file, "Garment OBJ file")->required();

@@ -69,7 +69,7 @@ int run(const RenderArgs& a) {
   return 0;
 }
 
-const Register reg("render", "ray-traced PNG of a body with one or two garments side by side",
+const Register render_command("render", "ray-traced PNG of a body with one or two garments side by side",
                    [](CLI::App& app) -> std::function<int()> {
                      auto args = std::make_shared<RenderArgs>();
                      app.add_option("--body", args->body, "body mesh")->required();

@@ -348,7 +348,7 @@ int run(ResizeArgs a) {
 // Switches that change the method or the solver: a help section of their own.
 constexpr const char* kAdvanced = "Advanced (method switches and solver internals; docs/method.md)";
 
-const Register reg("resize", "Resize a garment from body A to one or many bodies B", [](CLI::App& app) {
+const Register resize_command("resize", "Resize a garment from body A to one or many bodies B", [](CLI::App& app) {
   auto a = std::make_shared<ResizeArgs>();
   app.add_option("--garment", a->garment, "Garment OBJ around body A")->required();
   app.add_option("--from", a->from, "Body A (OBJ, PLY, OFF or STL)")->required();

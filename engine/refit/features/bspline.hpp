@@ -55,6 +55,12 @@ inline SegmentPoint closest_on_segment(const Vec3& q, const Vec3& a, const Vec3&
 /// Nearest point of a polyline (at least 1 row) to q; ties go to the first edge.
 PolylinePoint nearest_on_polyline(const Points& polyline, bool closed, const Vec3& q);
 
+/// The point at t (0..1) along segment `segment` of a polyline (a closed one's last wraps to row 0).
+inline Vec3 point_on(const Points& polyline, std::size_t segment, double t) {
+  const auto m = static_cast<std::size_t>(polyline.rows());
+  return (1.0 - t) * row3(polyline, Index(segment)) + t * row3(polyline, Index((segment + 1) % m));
+}
+
 /// m points spaced uniformly by arc length along a polyline (closed: first not repeated).
 /// Throws refit::Error when the polyline has fewer than 2 points or zero length.
 Points resample_polyline(const Points& polyline, std::size_t m, bool closed);

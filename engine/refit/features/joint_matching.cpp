@@ -20,6 +20,7 @@
 // equations accurate for long curves.
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
+#include <refit/features/bspline.hpp>
 #include <refit/features/curve_metrics.hpp>
 #include <refit/features/shape_matching.hpp>
 
@@ -41,11 +42,6 @@ using Cplx = std::complex<double>;
 using Row3 = Eigen::RowVector3d;
 
 Cplx cplx(const Vec2& v) { return {v.x(), v.y()}; }
-
-Vec3 point_on(const Points& poly, std::size_t segment, double t) {
-  const auto m = static_cast<std::size_t>(poly.rows());
-  return (1.0 - t) * row3(poly, Index(segment)) + t * row3(poly, Index((segment + 1) % m));
-}
 
 // One curve's move from the original to its target frame: the new plane, and
 // the similarity z -> a z + b (plane coordinates) that best carries the

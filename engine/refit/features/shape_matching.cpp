@@ -46,15 +46,6 @@ PolylinePoint nearest_near_vertex(const PointTree& tree, const Points& poly, boo
   return best;
 }
 
-namespace {
-
-Vec3 point_on(const Points& poly, std::size_t segment, double t) {
-  const std::size_t m = static_cast<std::size_t>(poly.rows());
-  return (1.0 - t) * row3(poly, static_cast<Index>(segment)) + t * row3(poly, static_cast<Index>((segment + 1) % m));
-}
-
-}  // namespace
-
 double shape_energy(const CurveShape& s, const Coords& x, const Coords& xw, const ShapeMatchingOptions& o) {
   const double wd = closeness_weight(o, static_cast<std::size_t>(x.rows()));
   const std::size_t m = static_cast<std::size_t>(x.rows());

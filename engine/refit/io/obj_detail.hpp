@@ -5,8 +5,10 @@
 // and warnings, and write the same bytes.
 #include <refit/io/obj_garment.hpp>
 
+#include <bit>
 #include <charconv>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -19,6 +21,9 @@ namespace refit::obj_detail {
 // boundaries depend only on the text, so results do not depend on the threads.
 inline constexpr std::size_t kChunkBytes = std::size_t(1) << 18;
 inline constexpr std::size_t kMaxWarnings = 20;
+
+// A written coordinate is kept as its text when its bits are the original's.
+inline bool same_bits(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); }
 
 struct ParseFailure {
   std::size_t line;  // 1-based, local to the chunk

@@ -16,8 +16,6 @@ namespace refit {
 namespace {
 using namespace obj_detail;
 
-bool same_bits(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); }
-
 }  // namespace
 
 ObjStream::ObjStream(std::string path, std::size_t group_bytes)

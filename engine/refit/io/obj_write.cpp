@@ -21,14 +21,13 @@
 namespace refit {
 namespace {
 using obj_detail::append_xyz;
+using obj_detail::same_bits;
 
 void append_index(std::string& out, std::size_t i) {
   char buf[24];
   const auto r = std::to_chars(buf, buf + sizeof buf, i);
   out.append(buf, r.ptr);
 }
-
-bool same_bits(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); }
 
 void check_finite(const Points& p, const std::string& where) {
   const std::size_t n = static_cast<std::size_t>(p.rows());

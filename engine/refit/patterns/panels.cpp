@@ -13,7 +13,7 @@ namespace refit {
 
 namespace {
 
-constexpr Index kNone = 0xffffffffu;
+constexpr Index kUnassigned = 0xffffffffu;
 
 class UnionFind {
  public:
@@ -175,10 +175,10 @@ PanelSet cut_panels(const Garment& g, const ObjFaceAttributes& at, std::span<con
 
   // Panels in order of their first face; panel vertices in order of first corner.
   set.face_panel.assign(nf, 0);
-  std::vector<Index> panel_of_root(nf, kNone), local(nf, 0);
+  std::vector<Index> panel_of_root(nf, kUnassigned), local(nf, 0);
   for (Index f = 0; f < nf; ++f) {
     const Index r = face_sets.find(f);
-    if (panel_of_root[r] == kNone) {
+    if (panel_of_root[r] == kUnassigned) {
       panel_of_root[r] = static_cast<Index>(set.panels.size());
       set.panels.emplace_back();
     }
@@ -188,12 +188,12 @@ PanelSet cut_panels(const Garment& g, const ObjFaceAttributes& at, std::span<con
     p.faces.push_back(f);
   }
   set.corner_vertex.assign(nc, 0);
-  std::vector<Index> vertex_of_root(nc, kNone);
+  std::vector<Index> vertex_of_root(nc, kUnassigned);
   for (Index f = 0; f < nf; ++f) {
     Panel& p = set.panels[set.face_panel[f]];
     for (Index c = faces.offsets[f]; c < faces.offsets[f + 1]; ++c) {
       const Index r = corner_sets.find(c);
-      if (vertex_of_root[r] == kNone) {
+      if (vertex_of_root[r] == kUnassigned) {
         vertex_of_root[r] = static_cast<Index>(p.vertices.size());
         p.vertices.push_back(faces.indices[c]);
       }

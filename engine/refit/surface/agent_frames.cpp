@@ -14,7 +14,7 @@
 namespace refit {
 
 namespace {
-constexpr std::size_t kGrain = 1024;
+constexpr std::size_t kFrameGrain = 1024;
 
 Vec3 any_perpendicular(const Vec3& n) {
   const Vec3 t = std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
@@ -25,7 +25,7 @@ Vec3 any_perpendicular(const Vec3& n) {
 void order_rings(const Points& x, Csr& ring, std::vector<std::uint8_t>& open) {
   const std::size_t n = ring.rows();
   open.assign(n, 0);
-  parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
+  parallel_for(0, n, kFrameGrain, [&](std::size_t b, std::size_t e) {
     std::vector<std::pair<double, Index>> ang;
     for (std::size_t a = b; a < e; ++a) {
       auto r = ring.row(a);
@@ -64,7 +64,7 @@ void order_rings(const Points& x, Csr& ring, std::vector<std::uint8_t>& open) {
 Points fan_normals(const Points& x, const Csr& ring, const std::vector<std::uint8_t>& open) {
   const std::size_t n = ring.rows();
   Points out = Points::Zero(static_cast<Eigen::Index>(n), 3);
-  parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
+  parallel_for(0, n, kFrameGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t a = b; a < e; ++a) {
       auto r = ring.row(a);
       if (r.size() < 2) continue;
@@ -140,7 +140,7 @@ AgentFrames agent_frames(const Points& x, const Csr& ring, const std::vector<std
   f.origin = x;
   f.axes.assign(n, Eigen::Matrix3d::Identity());
   f.valid.assign(n, 0);
-  parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
+  parallel_for(0, n, kFrameGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t a = b; a < e; ++a) {
       const Vec3 nrm = flip[a] * row3(normals, Index(a));
       if (nrm.squaredNorm() < 0.5) continue;
@@ -163,7 +163,7 @@ AgentFrames agent_frames(const Points& x, const Csr& ring, const std::vector<std
 std::vector<Eigen::Matrix3d> ring_rotations(const Points& from, const Points& to, const Csr& ring) {
   const std::size_t n = ring.rows();
   std::vector<Eigen::Matrix3d> out(n, Eigen::Matrix3d::Identity());
-  parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
+  parallel_for(0, n, kFrameGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t a = b; a < e; ++a) {
       auto r = ring.row(a);
       if (r.size() < 2) continue;

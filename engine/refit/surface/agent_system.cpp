@@ -12,7 +12,7 @@
 namespace refit {
 
 namespace {
-constexpr std::size_t kGrain = 1024;
+constexpr std::size_t kRowGrain = 1024;
 constexpr double kDegenerateDiag = 1e-4;
 
 // Integer block coordinates of every agent (origin at the agents' bounding box minimum).
@@ -21,7 +21,7 @@ std::vector<std::array<std::uint32_t, 3>> block_cells(const Points& x, double wi
   grid.h = width;
   if (x.rows() > 0) grid.origin = x.colwise().minCoeff().transpose();
   std::vector<std::array<std::uint32_t, 3>> c(static_cast<std::size_t>(x.rows()));
-  parallel_for(0, c.size(), kGrain, [&](std::size_t b, std::size_t e) {
+  parallel_for(0, c.size(), kRowGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) c[i] = grid.cell(row3(x, Index(i)));
   });
   return c;
@@ -42,7 +42,7 @@ AgentRows encode_agents(const Points& x, Csr ring) {
   rows.diag.assign(n, 0.0);
   rows.h = Points::Zero(static_cast<Eigen::Index>(n), 3);
   std::vector<std::uint8_t> degenerate(n, 0);
-  parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
+  parallel_for(0, n, kRowGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t a = b; a < e; ++a) {
       auto r = ring.row(a);
       if (r.empty()) continue;

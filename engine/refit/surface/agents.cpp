@@ -22,7 +22,7 @@ namespace refit {
 
 namespace {
 using namespace sampling;
-constexpr std::size_t kGrain = 2048;
+constexpr std::size_t kAgentGrain = 2048;
 constexpr std::uint32_t kMaxCell = (1u << 21) - 1;
 
 void check_garment(const Garment& g) {
@@ -68,7 +68,7 @@ sampling::SampleKey sample_key(const VoxelGrid& grid, const Vec3& p, std::uint64
 
 Points GarmentAgents::positions(const Points& x) const {
   Points out(static_cast<Eigen::Index>(size()), 3);
-  parallel_for(0, size(), kGrain, [&](std::size_t b, std::size_t e) {
+  parallel_for(0, size(), kAgentGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       Vec3 p = Vec3::Zero();
       for (int k = 0; k < 3; ++k) p += weight[i][k] * row3(x, vertex[i][k]);
@@ -81,13 +81,13 @@ Points GarmentAgents::positions(const Points& x) const {
 std::pair<double, double> surface_measure(const Garment& g) {
   check_garment(g);
   const Points& x = g.positions;
-  const double area = deterministic_sum(0, g.faces.rows(), kGrain, 0.0, [&](std::size_t f) {
+  const double area = deterministic_sum(0, g.faces.rows(), kAgentGrain, 0.0, [&](std::size_t f) {
     auto r = g.faces.row(f);
     double a = 0.0;
     for (std::size_t t = 1; t + 1 < r.size(); ++t) a += tri_area(row3(x, r[0]), row3(x, r[t]), row3(x, r[t + 1]));
     return a;
   });
-  const double length = deterministic_sum(0, g.lines.rows(), kGrain, 0.0, [&](std::size_t l) {
+  const double length = deterministic_sum(0, g.lines.rows(), kAgentGrain, 0.0, [&](std::size_t l) {
     auto r = g.lines.row(l);
     double s = 0.0;
     for (std::size_t t = 0; t + 1 < r.size(); ++t) s += (row3(x, r[t + 1]) - row3(x, r[t])).norm();
@@ -164,7 +164,7 @@ std::vector<std::uint32_t> garment_layers(const Garment& g, double min_area, dou
     for (std::size_t v = 0; v < n; ++v) unite_roots(parent, Index(v), weld[v]);
   }
   std::vector<double> face_area(g.faces.rows(), 0.0);
-  parallel_for(0, g.faces.rows(), kGrain, [&](std::size_t b, std::size_t e) {
+  parallel_for(0, g.faces.rows(), kAgentGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t f = b; f < e; ++f) {
       auto r = g.faces.row(f);
       for (std::size_t t = 1; t + 1 < r.size(); ++t)
@@ -214,7 +214,7 @@ GarmentAgents select_agents(const Garment& g, const VoxelGrid& grid, const std::
   std::vector<std::uint64_t> face_off(nf + 1, 0), line_off(nl + 1, 0);
   std::vector<std::uint32_t> face_m;  // subdivision of each fan triangle, flattened per face corner
   face_m.resize(g.faces.indices.size());
-  parallel_for(0, nf, kGrain, [&](std::size_t b, std::size_t e) {
+  parallel_for(0, nf, kAgentGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t f = b; f < e; ++f) {
       auto r = g.faces.row(f);
       std::uint64_t c = 0;
@@ -227,7 +227,7 @@ GarmentAgents select_agents(const Garment& g, const VoxelGrid& grid, const std::
     }
   });
   std::vector<std::uint32_t> line_m(g.lines.indices.size(), 0);
-  parallel_for(0, nl, kGrain, [&](std::size_t b, std::size_t e) {
+  parallel_for(0, nl, kAgentGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t l = b; l < e; ++l) {
       auto r = g.lines.row(l);
       std::uint64_t c = 0;
@@ -270,13 +270,13 @@ GarmentAgents select_agents(const Garment& g, const VoxelGrid& grid, const std::
   auto key_of = [&](std::uint64_t id, const Sample& s) {
     keys[id] = sample_key(grid, position(s), id, vertex_layer.empty() ? 0u : vertex_layer[s.v[0]]);
   };
-  parallel_for(0, nv, kGrain, [&](std::size_t b, std::size_t e) {
+  parallel_for(0, nv, kAgentGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) key_of(i, Sample{{Index(i), Index(i), Index(i)}, {1.0, 0.0, 0.0}});
   });
-  parallel_for(0, nf, kGrain / 4, [&](std::size_t b, std::size_t e) {
+  parallel_for(0, nf, kAgentGrain / 4, [&](std::size_t b, std::size_t e) {
     for (std::size_t f = b; f < e; ++f) visit_face(f, key_of);
   });
-  parallel_for(0, nl, kGrain / 4, [&](std::size_t b, std::size_t e) {
+  parallel_for(0, nl, kAgentGrain / 4, [&](std::size_t b, std::size_t e) {
     for (std::size_t l = b; l < e; ++l) visit_line(l, key_of);
   });
   // Keys are unique (the sample number is in them), so the sorted order, and the
@@ -298,7 +298,7 @@ GarmentAgents select_agents(const Garment& g, const VoxelGrid& grid, const std::
   out.weight.resize(na);
   out.voxel.resize(na);
   out.layer = std::move(winner_layer);
-  parallel_for(0, na, kGrain, [&](std::size_t b, std::size_t e) {
+  parallel_for(0, na, kAgentGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t a = b; a < e; ++a) {
       const std::uint64_t id = winners[a];
       Sample s{};

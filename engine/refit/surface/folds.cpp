@@ -13,7 +13,7 @@ namespace refit {
 
 namespace {
 
-constexpr std::size_t kGrain = 4096;
+constexpr std::size_t kFoldGrain = 4096;
 // A face counts as agreeing on the original only within 60 degrees of its
 // corners' normals: not at a crease (a collar's, a lapel's), where turning it
 // the other way is no fold.
@@ -30,10 +30,10 @@ struct Orientation {
 
   Orientation(const Garment& garment, const Csr& fov, const Points& positions)
       : g(garment), faces_of_vertex(fov), face(garment.faces.rows()), vertex(positions.rows()) {
-    parallel_for(0, face.size(), kGrain, [&](std::size_t b, std::size_t e) {
+    parallel_for(0, face.size(), kFoldGrain, [&](std::size_t b, std::size_t e) {
       for (std::size_t f = b; f < e; ++f) face[f] = face_normal(positions, g.faces.row(f));
     });
-    parallel_for(0, vertex.size(), kGrain, [&](std::size_t b, std::size_t e) {
+    parallel_for(0, vertex.size(), kFoldGrain, [&](std::size_t b, std::size_t e) {
       for (std::size_t v = b; v < e; ++v) vertex[v] = sum_at(Index(v));
     });
   }
@@ -104,11 +104,11 @@ struct Orientation {
   // parallel (each its own); returns their indices ascending.
   template <class Hit>
   static std::vector<Index> marked(std::vector<std::uint32_t>& marks, std::uint32_t mark, const Hit& hit) {
-    const std::size_t n = marks.size(), blocks = (n + kGrain - 1) / kGrain;
+    const std::size_t n = marks.size(), blocks = (n + kFoldGrain - 1) / kFoldGrain;
     std::vector<std::vector<Index>> found(blocks);
     parallel_for(0, blocks, 1, [&](std::size_t b, std::size_t e) {
       for (std::size_t blk = b; blk < e; ++blk)
-        for (std::size_t i = blk * kGrain; i < std::min(n, (blk + 1) * kGrain); ++i)
+        for (std::size_t i = blk * kFoldGrain; i < std::min(n, (blk + 1) * kFoldGrain); ++i)
           if (marks[i] != mark && hit(Index(i))) marks[i] = mark, found[blk].push_back(Index(i));
     });
     std::vector<Index> out;
@@ -211,7 +211,7 @@ std::vector<Index> reshape_leaning(const FoldBinding& binding, Orientation& o, P
   const std::size_t nf = g.faces.rows();
   const auto leaning = [&](std::size_t f) { return binding.agrees[f] && !o.agrees(f, kSmoothAround); };
   std::vector<std::uint8_t> leans(nf, 0);
-  parallel_for(0, nf, kGrain, [&](std::size_t b, std::size_t e) {
+  parallel_for(0, nf, kFoldGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t f = b; f < e; ++f) leans[f] = leaning(f);
   });
   std::vector<Index> lean, moved;
@@ -261,7 +261,7 @@ std::vector<Index> reshape_leaning(const FoldBinding& binding, Orientation& o, P
 std::vector<std::uint8_t> faces_agreeing(const Garment& g, const Csr& faces_of_vertex, const Points& positions) {
   const Orientation o(g, faces_of_vertex, positions);
   std::vector<std::uint8_t> agrees(g.faces.rows(), 0);
-  parallel_for(0, agrees.size(), kGrain, [&](std::size_t b, std::size_t e) {
+  parallel_for(0, agrees.size(), kFoldGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t f = b; f < e; ++f) agrees[f] = o.agrees(f, kSmoothAround);
   });
   return agrees;
@@ -285,7 +285,7 @@ FoldReport smooth_out_folds(const Garment& g, const FoldBinding& binding, Points
   const auto folded_at = [&](std::size_t f) { return folded_now(binding, o, positions, f); };
   const auto turned_at = [&](std::size_t f) { return binding.agrees[f] && !o.agrees(f); };
   std::vector<std::uint8_t> is_folded(nf, 0);  // here 1: turned, 2: only leaning and folded
-  parallel_for(0, nf, kGrain, [&](std::size_t b, std::size_t e) {
+  parallel_for(0, nf, kFoldGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t f = b; f < e; ++f)
       is_folded[f] = turned_at(f) ? 1 : binding.agrees[f] && !o.agrees(f, kSmoothAround) && turned_against_hood(o, positions, f) ? 2 : 0;
   });

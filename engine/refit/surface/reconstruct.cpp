@@ -16,7 +16,7 @@
 namespace refit {
 
 namespace {
-constexpr std::size_t kGrain = 1024;
+constexpr std::size_t kVertexGrain = 1024;
 }  // namespace
 
 VertexBlends SurfaceBinding::vertex_blends(const Points& positions, std::span<const std::uint32_t> vertex_layer) const {
@@ -114,7 +114,7 @@ std::size_t SurfaceBinding::follow_anchored(const Points& before, const std::vec
     const PointTree tree(before, solved);
     const double reach2 = std::pow(options_.reach_voxels * h_, 2);
     const Points correction = x - before;
-    parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
+    parallel_for(0, n, kVertexGrain, [&](std::size_t b, std::size_t e) {
       std::vector<Index> idx;
       std::vector<double> d2;
       for (std::size_t a = b; a < e; ++a) {
@@ -149,7 +149,7 @@ void SurfaceBinding::smooth_displacements(const Points& before, const std::vecto
   for (int pass = 0; pass < options_.smooth_passes; ++pass) {
     const Points d = x - (options_.emit_from_original && !options_.encode_on_warped ? original_agents_ : before);
     Points nx = x;
-    parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
+    parallel_for(0, n, kVertexGrain, [&](std::size_t b, std::size_t e) {
       for (std::size_t a = b; a < e; ++a) {
         if (!fr[a] || ring_.row_size(a) == 0) continue;
         Vec3 m = Vec3::Zero();

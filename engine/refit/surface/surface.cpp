@@ -20,14 +20,14 @@
 namespace refit {
 
 namespace {
-constexpr std::size_t kGrain = 1024;
+constexpr std::size_t kSurfaceGrain = 1024;
 
 // h of eq. 13 for the agents of `r`, each turned by its agent's rotation in
 // `turn` (rotate_encoding; empty: as encoded). agent: fine slot of each row.
 Points turned_h(const AgentRows& r, const std::vector<Index>* agent, const std::vector<Eigen::Matrix3d>& turn) {
   Points h = r.h;
   if (!turn.empty())
-    parallel_for(0, r.size(), kGrain, [&](std::size_t b, std::size_t e) {
+    parallel_for(0, r.size(), kSurfaceGrain, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
         const Index a = agent ? (*agent)[i] : Index(i);
         h.row(Eigen::Index(i)) = (turn[a] * row3(r.h, Index(i))).transpose();
@@ -84,7 +84,7 @@ template <class Vertex>
 Points SurfaceBinding::agent_positions_of(const Vertex& x, const Points* fp) const {
   const std::size_t n = agent_count();
   Points out(static_cast<Eigen::Index>(n), 3);
-  parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
+  parallel_for(0, n, kSurfaceGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t a = b; a < e; ++a) {
       Vec3 p = Vec3::Zero();
       const std::int32_t k = feature_of_[a];
@@ -154,7 +154,7 @@ Points SurfaceBinding::coarse_to_fine_start(const Points& before, const Points& 
   Points x = before;
   if (!levels_.empty()) {
     const CoarseLevel& below = levels_.front();
-    parallel_for(0, n, kGrain, [&](std::size_t b, std::size_t e) {
+    parallel_for(0, n, kSurfaceGrain, [&](std::size_t b, std::size_t e) {
       for (std::size_t a = b; a < e; ++a) {
         if (!fine_free[a]) continue;
         Vec3 d = Vec3::Zero();
@@ -220,13 +220,13 @@ SnapReach SurfaceBinding::snap_reach(const Points& positions, std::span<const st
   for (std::size_t k = 0; k < nf; ++k) samples.row(Eigen::Index(k)) = original_agents_.row(feature_slot_[k]);
   const PointTree tree(samples);
   // Fixed blocks, each with its own lists, joined in block order: the same for any thread count.
-  const std::size_t blocks = (nv + kGrain - 1) / kGrain;
+  const std::size_t blocks = (nv + kSurfaceGrain - 1) / kSurfaceGrain;
   std::vector<std::vector<Index>> slots(blocks);
   std::vector<std::vector<float>> weights(blocks);
   parallel_for(0, blocks, 1, [&](std::size_t b, std::size_t e) {
     std::vector<std::pair<Index, double>> near;
     for (std::size_t blk = b; blk < e; ++blk)
-      for (std::size_t v = blk * kGrain; v < std::min(nv, (blk + 1) * kGrain); ++v) {
+      for (std::size_t v = blk * kSurfaceGrain; v < std::min(nv, (blk + 1) * kSurfaceGrain); ++v) {
         // A vertex of a layer is moved by its own layer's feature agents only (as it blends its own layer's agents).
         const std::uint32_t own = layer.empty() ? 0u : layer[v];
         tree.within(row3(positions, Index(v)), r2, near);
