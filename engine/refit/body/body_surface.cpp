@@ -587,6 +587,20 @@ bool BodySurface::inside(const Vec3& p) const {
   return impl_->inside_given(impl_->query(p, impl_->near_tolerance));
 }
 
+SignedClosestPoint BodySurface::inside_or_clear(const Vec3& p) const {
+  SignedClosestPoint r;
+  if (!p.allFinite()) return r;
+  const std::uint8_t g = impl_->grid_label(p);
+  if (g != Impl::kBoundary) {
+    r.inside = g == Impl::kInside;
+    return r;
+  }
+  const PointQueryData d = impl_->query(p, impl_->near_tolerance);
+  r.inside = impl_->inside_given(d);
+  if (!r.inside && d.best_d2 > 0.0) r.clear = std::isfinite(d.best_d2) ? std::sqrt(d.best_d2) : impl_->near_tolerance;
+  return r;
+}
+
 SignedClosestPoint BodySurface::closest_and_inside(const Vec3& p, double max_distance) const {
   SignedClosestPoint r;
   if (!p.allFinite()) {
@@ -601,14 +615,17 @@ SignedClosestPoint BodySurface::closest_and_inside(const Vec3& p, double max_dis
   }
   if (g == Impl::kOutside) {
     static_cast<ClosestPoint&>(r) = closest_within(p, max_distance);
+    r.clear = std::min(r.distance, max_distance);
     return r;
   }
   // inside() queries as far as near_tolerance; one query as far as both need
   // finds the same closest point (ties go to the lowest triangle either way).
-  PointQueryData d = impl_->query(p, std::max(max_distance, impl_->near_tolerance));
+  const double searched = std::max(max_distance, impl_->near_tolerance);
+  PointQueryData d = impl_->query(p, searched);
   PointQueryData near = d;
   if (near.best_d2 > impl_->near_tolerance * impl_->near_tolerance) near.best_d2 = kInf;
   r.inside = impl_->inside_given(near);
+  if (!r.inside && d.best_d2 > 0.0) r.clear = std::isfinite(d.best_d2) ? std::sqrt(d.best_d2) : searched;
   if (r.inside && !std::isfinite(d.best_d2)) d = impl_->query(p, kInf);
   if (!r.inside && d.best_d2 > max_distance * max_distance) d.best_d2 = kInf;
   static_cast<ClosestPoint&>(r) = closest_of(d, impl_->face_normal);
@@ -616,21 +633,42 @@ SignedClosestPoint BodySurface::closest_and_inside(const Vec3& p, double max_dis
 }
 
 void BodySurface::near(const Vec3& p, double radius, Near& out) const {
-  out.vertices.clear();
+  out.points.clear();
+  out.within = 0;
   out.edges.clear();
   if (!(radius > 0.0)) return;
   const Impl& m = *impl_;
-  std::vector<std::pair<Index, double>> found;
+  thread_local std::vector<std::pair<Index, double>> found;
   m.vertex_tree->within(p, radius * radius, found);
-  std::vector<Index> in;
-  for (const auto& [i, d2] : found) {
-    out.vertices.push_back(row3(m.vertices, i));
-    in.push_back(i);
-  }
+  // Per body vertex, its row of out.points (kNone: none), for the ends of the
+  // edges: a face's call asks it of every neighbour of some 30 vertices. Kept
+  // between calls (a body's worth of rows), the marked rows cleared on return.
+  constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+  thread_local std::vector<std::uint32_t> row_of;
+  thread_local std::vector<Index> marked;
+  if (row_of.size() < std::size_t(m.vertices.rows())) row_of.resize(std::size_t(m.vertices.rows()), kNone);
+  struct Unmark {
+    ~Unmark() {
+      for (const Index v : marked) row_of[v] = kNone;
+      marked.clear();
+    }
+  } unmark;
+  const auto add = [&](Index v) {
+    row_of[v] = std::uint32_t(out.points.size());
+    marked.push_back(v);
+    out.points.push_back(row3(m.vertices, v));
+  };
+  for (const auto& [v, d2] : found) add(v);
+  out.within = out.points.size();
+  thread_local std::vector<Index> in;
+  in.assign(marked.begin(), marked.end());
   std::sort(in.begin(), in.end());
   for (const Index v : in)
-    for (const Index w : m.neighbours.row(v))  // once: from its smaller end, or from its only end within
-      if (v < w || !std::binary_search(in.begin(), in.end(), w)) out.edges.push_back({row3(m.vertices, v), row3(m.vertices, w)});
+    for (const Index w : m.neighbours.row(v)) {  // once: from its smaller end, or from its only end within
+      if (!(v < w || !(row_of[w] < out.within))) continue;
+      if (row_of[w] == kNone) add(w);  // an end outside the radius, once
+      out.edges.push_back({row_of[v], row_of[w]});
+    }
 }
 
 double BodySurface::signed_distance(const Vec3& p) const {

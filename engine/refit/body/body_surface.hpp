@@ -19,6 +19,10 @@ struct ClosestPoint {
 /// A closest point and, when one was found, whether the query point is inside.
 struct SignedClosestPoint : ClosestPoint {
   bool inside = false;  // decided as inside() does; false (and meaningless) when distance is +inf
+  // How far p is known to be outside the body: the distance the query found
+  // or the radius it searched in vain, even beyond max_distance (0 when inside
+  // or unknown). The open ball of this radius about p holds no body point.
+  double clear = 0.0;
 };
 
 /// Closest point to p on triangle abc (exact, in double).
@@ -49,18 +53,23 @@ class BodySurface {
   SignedClosestPoint closest_and_inside(const Vec3& p, double max_distance) const;
   /// True when p is inside the closed body (ray parity, majority over several directions).
   bool inside(const Vec3& p) const;
+  /// inside(p), and how far p is known to be outside (SignedClosestPoint::clear;
+  /// the other fields are not set).
+  SignedClosestPoint inside_or_clear(const Vec3& p) const;
   /// Builds the inside test's lookup grid now; otherwise the first inside() call
   /// builds it. Call it before a parallel loop of inside() tests: built from
   /// within one, the other threads wait for it and it runs on one thread.
   void prepare_inside_test() const;
   /// Negative inside, positive outside.
   double signed_distance(const Vec3& p) const;
-  /// The body's vertices within `radius` of p (positions, closest first), and
-  /// the edges with an end among them (each once): what can rise through a
-  /// garment face there.
+  /// The body's vertices within `radius` of p (the first `within` points,
+  /// closest first), and the edges with an end among them (each once, as two
+  /// rows of `points`; an end outside the radius follows the vertices): what
+  /// can rise through a garment face there.
   struct Near {
-    std::vector<Vec3> vertices;
-    std::vector<std::array<Vec3, 2>> edges;
+    std::vector<Vec3> points;
+    std::size_t within = 0;
+    std::vector<std::array<std::uint32_t, 2>> edges;
   };
   void near(const Vec3& p, double radius, Near& out) const;
   /// Ray cast: distance along unit dir to the first hit, +inf if none; tri_out gets the triangle.

@@ -90,11 +90,6 @@ Constraint constraint_at(const Vec3& p, bool in, const ClosestPoint& cp, double 
   return c;
 }
 
-Constraint check_vertex(const Vec3& p, const BodySurface& body, double clearance) {
-  const SignedClosestPoint at = body.closest_and_inside(p, clearance);
-  return constraint_at(p, at.inside, at, clearance);
-}
-
 // Corner mean of face f.
 Vec3 face_centre(const Garment& g, const Points& positions, std::size_t f) {
   Vec3 centre = Vec3::Zero();
@@ -184,10 +179,29 @@ bool face_needs(const Garment& g, const Points& positions, std::size_t f, const 
   // `spare_pinned`: the point asks the corners that are not pinned (the corners
   // of the faces the curves sit on), when it has weight on them, so that a face
   // next to a curve comes off a bump without moving the curve's face.
+  // The points asked so far that the body stays away from, with how far: a
+  // later point well within one of their balls clears the body too (a coarse
+  // face's samples and probes lie close together).
+  thread_local std::vector<std::pair<Vec3, double>> clear_balls;
+  clear_balls.clear();
+  const auto clear_by_a_ball = [&](const Vec3& q) {
+    return std::any_of(clear_balls.begin(), clear_balls.end(),
+                       [&](const auto& b) { return b.second - (q - b.first).norm() >= clearance + margin; });
+  };
+  const auto remember = [&](const Vec3& q, double clear) {
+    constexpr std::size_t kBalls = 32;
+    if (clear > clearance + margin && clear_balls.size() < kBalls) clear_balls.emplace_back(q, clear);
+  };
   const auto test = [&](std::size_t k, const Vec3& q, std::array<double, 3> w, double keep, bool spare_pinned) {
-    if ((q - centre).norm() <= clear_within || clear_by_a_corner(q)) return false;
-    if (!need) return body.inside(q);
-    const Constraint s = check_vertex(q, body, keep);
+    if ((q - centre).norm() <= clear_within || clear_by_a_corner(q) || clear_by_a_ball(q)) return false;
+    if (!need) {
+      const SignedClosestPoint at = body.inside_or_clear(q);
+      remember(q, at.clear);
+      return at.inside;
+    }
+    const SignedClosestPoint at = body.closest_and_inside(q, keep);
+    remember(q, at.clear);
+    const Constraint s = constraint_at(q, at.inside, at, keep);
     if (!s.active) return false;
     inside = inside || s.inside;
     const std::array<std::size_t, 3> corner = {0, k, k + 1};
@@ -208,8 +222,12 @@ bool face_needs(const Garment& g, const Points& positions, std::size_t f, const 
   // points right over the body's vertices nearby out of the body, by a fifth of
   // the face clearance only: kept as far off as the samples, they lifted the
   // coarse garments off the body by up to 0.1 cm more than they needed.
-  BodySurface::Near bumps;
+  thread_local BodySurface::Near bumps;  // a face's, its buffers kept for the next face
+  bumps.points.clear();
+  bumps.within = 0;
+  bumps.edges.clear();
   if (radius > probe_radius) body.near(centre, 2.0 * radius + clearance, bumps);  // a vertex deep through the face lies off its plane
+  thread_local std::vector<std::array<double, 2>> over_at;  // each of bumps.points over the fan triangle
   const double keep = 0.2 * clearance;
   const Vec3 a = row3(positions, face[0]);
   for (std::size_t k = 1; k + 1 < face.size(); ++k) {
@@ -218,23 +236,34 @@ bool face_needs(const Garment& g, const Points& positions, std::size_t f, const 
       if (test(k, w[0] * a + w[1] * b + w[2] * c, {w[0], w[1], w[2]}, clearance, false) && !need) return true;
     const Vec3 ab = b - a, ac = c - a;
     const double d00 = ab.dot(ab), d01 = ab.dot(ac), d11 = ac.dot(ac), det = d00 * d11 - d01 * d01;
-    if (bumps.vertices.empty() || !(det > 1e-12 * d00 * d11)) continue;  // a sliver: its samples cover it
-    // (s, t): where a point falls over the triangle's plane, a + s ab + t ac.
-    const auto over = [&](const Vec3& v) {
-      const Vec3 av = v - a;
-      return std::array<double, 2>{(d11 * av.dot(ab) - d01 * av.dot(ac)) / det, (d00 * av.dot(ac) - d01 * av.dot(ab)) / det};
-    };
+    if (bumps.within == 0 || !(det > 1e-12 * d00 * d11)) continue;  // a sliver: its samples cover it
+    // (s, t): where a point falls over the triangle's plane, a + s ab + t ac;
+    // once per point (a vertex ends several edges).
+    over_at.resize(bumps.points.size());
+    for (std::size_t i = 0; i < bumps.points.size(); ++i) {
+      const Vec3 av = bumps.points[i] - a;
+      over_at[i] = {(d11 * av.dot(ab) - d01 * av.dot(ac)) / det, (d00 * av.dot(ac) - d01 * av.dot(ab)) / det};
+    }
     const auto probe = [&](double s, double t) {
       return test(k, a + s * ab + t * ac, {1.0 - s - t, s, t}, keep, true) && !need;
     };
     // The body over the triangle is highest at a body vertex over it, or where a
     // body edge crosses one of its sides (its corners are tested as vertices).
-    for (const Vec3& v : bumps.vertices) {
-      const auto [s, t] = over(v);
+    for (std::size_t i = 0; i < bumps.within; ++i) {
+      const auto [s, t] = over_at[i];
       if (s >= 0.0 && t >= 0.0 && s + t <= 1.0 && probe(s, t)) return true;
     }
+    // A crossing point lies between its edge's ends, so an edge with both ends
+    // beyond the same side (by more than the tolerances below and the rounding
+    // of the crossing's interpolation) crosses none within the triangle: most
+    // of a coarse face's nearby body edges.
+    const auto below = [](double x0, double x1, double bound) {
+      return std::max(x0, x1) < bound - 1e-9 * (1.0 + std::abs(x0) + std::abs(x1));
+    };
     for (const auto& e : bumps.edges) {
-      const auto p0 = over(e[0]), p1 = over(e[1]);
+      const auto& p0 = over_at[e[0]];
+      const auto& p1 = over_at[e[1]];
+      if (below(p0[0], p1[0], 0.0) || below(p0[1], p1[1], 0.0) || below(-p0[0] - p0[1], -p1[0] - p1[1], -1.0)) continue;
       // The sides s = 0, t = 0 and s + t = 1, each as g(s, t) = 0 with the
       // triangle on g >= 0: the edge crosses a side where g changes sign.
       static constexpr double kSides[3][3] = {{1, 0, 0}, {0, 1, 0}, {-1, -1, 1}};
@@ -385,9 +414,11 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
             ok = ok && finite[v];
           }
           if (!check || !ok) continue;
-          // Only counted (not asked of) while a corner is constrained, so only inside or not is needed.
+          // Only counted (not asked of) while a corner is constrained, so only
+          // inside or not is needed, and only for round 1's count.
           const bool waits =
               !last_round && std::any_of(face.begin(), face.end(), [&](Index v) { return constrained[v] != 0; });
+          if (waits && !all) continue;
           const bool in =
               face_needs(g, positions, f, body_b, options.face_clearance, options.probe_radius, options.pinned,
                          &outside_by, waits ? nullptr : &need);
