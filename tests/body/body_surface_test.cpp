@@ -337,5 +337,46 @@ TEST(BodySurface, ClosestAndInsideAnswersAsInsideThenClosest) {
   EXPECT_GT(outside_none, 500u);
 }
 
+TEST(BodySurface, ClearBallsHoldNoBodyPoint) {
+  // The collision step skips a face's points inside the balls earlier queries
+  // left clear: each `clear` must be no more than the point's true distance to
+  // the body (0 inside), and as much as it where the query found the closest;
+  // inside_or_clear answers inside() as it does.
+  const std::string dir = test::shared_data_dir();
+  if (dir.empty()) GTEST_SKIP() << "shared data (../shared/data) not found";
+  const BodyMesh m = load_obj_body(dir + "/bodies/F_heavier.obj");
+  const BodySurface s(m);
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<std::size_t> pick(0, m.vertices.rows() - 1);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::size_t cleared = 0, exact = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const Vec3 dir3 = Vec3(unit(rng), unit(rng), unit(rng)).normalized();
+    const double offset = std::array<double, 6>{0.01, 0.1, 0.3, 1.0, 3.0, 8.0}[std::size_t(i) % 6];
+    const Vec3 p = row3(m.vertices, Index(pick(rng))) + offset * dir3;
+    const bool in = s.inside(p);
+    const double distance = s.closest(p).distance;
+    const SignedClosestPoint o = s.inside_or_clear(p);
+    ASSERT_EQ(o.inside, in) << i;
+    ASSERT_LE(o.clear, distance) << i;
+    if (in) {
+      ASSERT_EQ(o.clear, 0.0) << i;
+    }
+    for (double radius : {0.01, 0.2, 1.0}) {
+      const SignedClosestPoint c = s.closest_and_inside(p, radius);
+      ASSERT_LE(c.clear, distance) << i << " radius " << radius;
+      if (in) {
+        ASSERT_EQ(c.clear, 0.0) << i;
+      } else if (std::isfinite(c.distance)) {
+        ASSERT_EQ(c.clear, c.distance) << i;
+      }
+      cleared += c.clear > radius;
+      exact += !in && c.clear == distance;
+    }
+  }
+  EXPECT_GT(cleared, 1000u);  // the balls reach beyond the radius asked: what the skipping gains
+  EXPECT_GT(exact, 1000u);
+}
+
 }  // namespace
 }  // namespace refit
