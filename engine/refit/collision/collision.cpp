@@ -152,17 +152,25 @@ bool face_needs(const Garment& g, const Points& positions, std::size_t f, const 
   double radius = 0.0;
   for (Index v : face) radius = std::max(radius, (row3(positions, v) - centre).norm());
   const double margin = 1e-9 * (1.0 + centre.cwiseAbs().maxCoeff() + radius);  // rounding
-  const auto clear_by_a_corner = [&](const Vec3& q) {
-    if (!outside_by) return false;
-    for (Index v : face)
-      if ((*outside_by)[v] - (q - row3(positions, v)).norm() >= clearance + margin) return true;
-    return false;
+  // Balls the body stays out of by the clearance (and a rounding margin): a
+  // point of the face inside one clears the body without a query. Each ball is
+  // a point known to be outside the body by some distance, less the clearance
+  // (the distance to the body changes no faster than the point moves): the
+  // corners' (outside_by), the centre's once asked, then every point asked (a
+  // coarse face's samples and probes lie close together). As (point, squared radius).
+  thread_local std::vector<std::pair<Vec3, double>> clear_balls;
+  clear_balls.clear();
+  const auto add_ball = [&](const Vec3& q, double known_outside_by) {
+    const double r = known_outside_by - clearance - margin;
+    if (r > 0.0) clear_balls.emplace_back(q, r * r);
   };
-  // The distance to the body changes no faster than the point moves: a sample
-  // closer to an outside centre than the centre's distance less the clearance
-  // clears the body too.
-  double clear_within = -1.0;
-  if (!clear_by_a_corner(centre)) {
+  if (outside_by)
+    for (Index v : face) add_ball(row3(positions, v), (*outside_by)[v]);
+  const auto clear_by_a_ball = [&](const Vec3& q) {
+    return std::any_of(clear_balls.begin(), clear_balls.end(),
+                       [&](const auto& b) { return (q - b.first).squaredNorm() <= b.second; });
+  };
+  if (!clear_by_a_ball(centre)) {
     const SignedClosestPoint at = body.closest_and_inside(centre, radius + clearance);
     const bool centre_in = at.inside;
     if (centre_in && !need) return true;
@@ -172,28 +180,19 @@ bool face_needs(const Garment& g, const Points& positions, std::size_t f, const 
       inside = at_centre.inside;
       for (std::size_t i = 0; i < face.size(); ++i) ask(i, at_centre, 1.0);
     }
-    if (!centre_in) clear_within = at.distance - clearance - margin;
+    if (!centre_in) add_ball(centre, at.distance);
   }
+  const auto remember = [&](const Vec3& q, double clear) {
+    constexpr std::size_t kBalls = 40;
+    if (clear_balls.size() < kBalls) add_ball(q, clear);
+  };
   // One point of fan triangle (a, b, c) = (0, k, k + 1), with weights w: true
   // when, asked only for inside or not, it is inside.
   // `spare_pinned`: the point asks the corners that are not pinned (the corners
   // of the faces the curves sit on), when it has weight on them, so that a face
   // next to a curve comes off a bump without moving the curve's face.
-  // The points asked so far that the body stays away from, with how far: a
-  // later point well within one of their balls clears the body too (a coarse
-  // face's samples and probes lie close together).
-  thread_local std::vector<std::pair<Vec3, double>> clear_balls;
-  clear_balls.clear();
-  const auto clear_by_a_ball = [&](const Vec3& q) {
-    return std::any_of(clear_balls.begin(), clear_balls.end(),
-                       [&](const auto& b) { return b.second - (q - b.first).norm() >= clearance + margin; });
-  };
-  const auto remember = [&](const Vec3& q, double clear) {
-    constexpr std::size_t kBalls = 32;
-    if (clear > clearance + margin && clear_balls.size() < kBalls) clear_balls.emplace_back(q, clear);
-  };
   const auto test = [&](std::size_t k, const Vec3& q, std::array<double, 3> w, double keep, bool spare_pinned) {
-    if ((q - centre).norm() <= clear_within || clear_by_a_corner(q) || clear_by_a_ball(q)) return false;
+    if (clear_by_a_ball(q)) return false;
     if (!need) {
       const SignedClosestPoint at = body.inside_or_clear(q);
       remember(q, at.clear);
