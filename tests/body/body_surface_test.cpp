@@ -302,21 +302,32 @@ TEST(BodySurface, MakeHumanBodyAgainstBruteForce) {
   check_against_brute_force(m, 1500, 5);
 }
 
+// 4000 points from deep inside to far outside a body (its inside grid's
+// inside, outside and boundary cells): off random vertices in random directions.
+std::vector<Vec3> points_around(const BodyMesh& m, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<std::size_t> pick(0, m.vertices.rows() - 1);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::vector<Vec3> points;
+  for (int i = 0; i < 4000; ++i) {
+    const Vec3 dir3 = Vec3(unit(rng), unit(rng), unit(rng)).normalized();
+    const double offset = std::array<double, 6>{0.01, 0.1, 0.3, 1.0, 3.0, 8.0}[std::size_t(i) % 6];
+    points.push_back(row3(m.vertices, Index(pick(rng))) + offset * dir3);
+  }
+  return points;
+}
+
 TEST(BodySurface, ClosestAndInsideAnswersAsInsideThenClosest) {
-  // Points from deep inside to far outside a real body (and its grid's inside,
-  // outside and boundary cells): the one-query answer is the two-query one, exactly.
+  // Points from deep inside to far outside a real body: the one-query answer is
+  // the two-query one, exactly.
   const std::string dir = test::shared_data_dir();
   if (dir.empty()) GTEST_SKIP() << "shared data (../shared/data) not found";
   const BodyMesh m = load_obj_body(dir + "/bodies/F_heavier.obj");
   const BodySurface s(m);
-  std::mt19937 rng(7);
-  std::uniform_int_distribution<std::size_t> pick(0, m.vertices.rows() - 1);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
   std::size_t inside = 0, outside_near = 0, outside_none = 0;
-  for (int i = 0; i < 4000; ++i) {
-    const Vec3 dir3 = Vec3(unit(rng), unit(rng), unit(rng)).normalized();
-    const double offset = std::array<double, 6>{0.01, 0.1, 0.3, 1.0, 3.0, 8.0}[std::size_t(i) % 6];
-    const Vec3 p = row3(m.vertices, Index(pick(rng))) + offset * dir3;
+  const std::vector<Vec3> points = points_around(m, 7);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Vec3& p = points[i];
     for (double radius : {0.2, 1.0}) {
       const SignedClosestPoint both = s.closest_and_inside(p, radius);
       const bool in = s.inside(p);
@@ -346,14 +357,10 @@ TEST(BodySurface, ClearBallsHoldNoBodyPoint) {
   if (dir.empty()) GTEST_SKIP() << "shared data (../shared/data) not found";
   const BodyMesh m = load_obj_body(dir + "/bodies/F_heavier.obj");
   const BodySurface s(m);
-  std::mt19937 rng(11);
-  std::uniform_int_distribution<std::size_t> pick(0, m.vertices.rows() - 1);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
   std::size_t cleared = 0, exact = 0;
-  for (int i = 0; i < 4000; ++i) {
-    const Vec3 dir3 = Vec3(unit(rng), unit(rng), unit(rng)).normalized();
-    const double offset = std::array<double, 6>{0.01, 0.1, 0.3, 1.0, 3.0, 8.0}[std::size_t(i) % 6];
-    const Vec3 p = row3(m.vertices, Index(pick(rng))) + offset * dir3;
+  const std::vector<Vec3> points = points_around(m, 11);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Vec3& p = points[i];
     const bool in = s.inside(p);
     const double distance = s.closest(p).distance;
     const SignedClosestPoint o = s.inside_or_clear(p);
