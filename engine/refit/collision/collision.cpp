@@ -318,6 +318,19 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   report.checked = deterministic_sum<std::size_t>(0, n, kGrain, 0, [&](std::size_t i) { return finite[i]; });
   std::vector<std::uint8_t> is_touched(n, 0);
   std::vector<std::uint8_t> face_inside_before;  // per face: its centre inside body B before
+  // Moves are counted as they are applied (a round's corrections, an after-rounds
+  // pass): per vertex, the count after its last move; per face, 1 + the count
+  // when it was last found with no point inside (0: never). A face none of whose
+  // corners moved since is still clear: the count after the rounds asks it again
+  // only otherwise (most of a coarse garment's faces were asked in the last round).
+  std::uint32_t moves_done = 0;
+  std::vector<std::uint32_t> moved_at(n, 0);
+  std::vector<std::uint32_t> clear_at(g.faces.rows(), 0);
+  const auto still_clear = [&](std::size_t f) {
+    if (clear_at[f] == 0) return false;
+    const auto face = g.faces.row(f);
+    return std::all_of(face.begin(), face.end(), [&](Index v) { return moved_at[v] < clear_at[f]; });
+  };
   std::vector<Vec3> first_position;  // aligned with `touched`: where each started
   std::vector<Index> touched_slot(n, 0);  // a touched vertex's slot in `touched`
 
@@ -422,6 +435,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
               face_needs(g, positions, f, body_b, options.face_clearance, options.probe_radius, options.pinned,
                          &outside_by, waits ? nullptr : &need);
           faces_in[blk] += in;
+          if (!in) clear_at[f] = moves_done + 1;
           if (all) face_inside_before[f] = in;
           if (waits) continue;
           for (std::size_t i = 0; i < face.size(); ++i)
@@ -577,10 +591,11 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     if (options.pinned)
       for (std::size_t k = 0; k < m; ++k)
         if ((*options.pinned)[region[k]] && !con_at[k]) disp[k] = Vec3::Zero();
+    ++moves_done;
     parallel_for(0, m, 1024, [&](std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e; ++k) {
         positions.row(region[k]) += disp[k].transpose();
-        if (disp[k] != Vec3::Zero()) outside_by[region[k]] = 0.0;  // unknown until checked again
+        if (disp[k] != Vec3::Zero()) outside_by[region[k]] = 0.0, moved_at[region[k]] = moves_done;  // unknown until checked again
       }
     });
     for (Index i : region) ring[i] = -1, slot[i] = -1;
@@ -595,10 +610,12 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   // same figures, and on the 1M dress the step took 2.7 s with 1 and 3.2 s with 5.
   for (int pass = 0; options.after_rounds && pass < options.after_rounds_passes; ++pass) {
     to_check.clear();
+    ++moves_done;
     for (const auto& [i, p] : options.after_rounds(positions)) {
       touch(i);
       positions.row(i) = p.transpose();
       outside_by[i] = 0.0;
+      moved_at[i] = moves_done;
       to_check.push_back(i);
     }
     if (to_check.empty()) break;
@@ -623,7 +640,12 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
       for (std::size_t f = b; f < e; ++f) {
         const auto face = g.faces.row(f);
         const bool moved = std::any_of(face.begin(), face.end(), [&](Index v) { return is_touched[v] != 0; });
-        face_in[f] = moved ? face_inside(g, positions, f, body_b, options.probe_radius, outside_by) : face_inside_before[f];
+        if (!moved) {
+          face_in[f] = face_inside_before[f];
+        } else if (!still_clear(f)) {
+          face_in[f] = face_inside(g, positions, f, body_b, options.probe_radius, outside_by);
+          if (!face_in[f]) clear_at[f] = moves_done + 1;
+        }
       }
     });
     report.faces_inside_after = std::size_t(std::count(face_in.begin(), face_in.end(), 1));
