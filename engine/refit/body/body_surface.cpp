@@ -566,6 +566,13 @@ BodySurface& BodySurface::operator=(BodySurface&&) noexcept = default;
 ClosestPoint BodySurface::closest(const Vec3& p) const { return closest_within(p, kInf); }
 
 namespace {
+// How far p is known to be outside, given that it is and the query `d` that
+// searched as far as `searched`: its distance, or the radius when it found nothing.
+double known_clear(const PointQueryData& d, double searched) {
+  if (!(d.best_d2 > 0.0)) return 0.0;
+  return std::isfinite(d.best_d2) ? std::sqrt(d.best_d2) : searched;
+}
+
 ClosestPoint closest_of(const PointQueryData& d, const Points& face_normal) {
   ClosestPoint r;
   if (!std::isfinite(d.best_d2)) {
@@ -605,13 +612,7 @@ SignedClosestPoint BodySurface::signed_closest_within(const Vec3& p, double max_
 
 void BodySurface::prepare_inside_test() const { impl_->ensure_grid(); }
 
-bool BodySurface::inside(const Vec3& p) const {
-  if (!p.allFinite()) return false;
-  const std::uint8_t g = impl_->grid_label(p);
-  if (g != Impl::kBoundary) return g == Impl::kInside;
-  // Only a nearby closest point is needed: farther points go to the rays anyway.
-  return impl_->inside_given(impl_->query(p, impl_->near_tolerance));
-}
+bool BodySurface::inside(const Vec3& p) const { return inside_or_clear(p).inside; }
 
 SignedClosestPoint BodySurface::inside_or_clear(const Vec3& p) const {
   SignedClosestPoint r;
@@ -621,9 +622,10 @@ SignedClosestPoint BodySurface::inside_or_clear(const Vec3& p) const {
     r.inside = g == Impl::kInside;
     return r;
   }
+  // Only a nearby closest point is needed: farther points go to the rays anyway.
   const PointQueryData d = impl_->query(p, impl_->near_tolerance);
   r.inside = impl_->inside_given(d);
-  if (!r.inside && d.best_d2 > 0.0) r.clear = std::isfinite(d.best_d2) ? std::sqrt(d.best_d2) : impl_->near_tolerance;
+  if (!r.inside) r.clear = known_clear(d, impl_->near_tolerance);
   return r;
 }
 
@@ -651,7 +653,7 @@ SignedClosestPoint BodySurface::closest_and_inside(const Vec3& p, double max_dis
   PointQueryData near = d;
   if (near.best_d2 > impl_->near_tolerance * impl_->near_tolerance) near.best_d2 = kInf;
   r.inside = impl_->inside_given(near);
-  if (!r.inside && d.best_d2 > 0.0) r.clear = std::isfinite(d.best_d2) ? std::sqrt(d.best_d2) : searched;
+  if (!r.inside) r.clear = known_clear(d, searched);
   if (r.inside && !std::isfinite(d.best_d2)) d = impl_->query(p, kInf);
   if (!r.inside && d.best_d2 > max_distance * max_distance) d.best_d2 = kInf;
   static_cast<ClosestPoint&>(r) = closest_of(d, impl_->face_normal);
