@@ -100,6 +100,10 @@ ASSERTED = ["flipped", "inside_vertices", "inside_faces", "mirror", "height", "h
 ASSERTED_SHARED_ONLY = ["feature_gap"]
 # A face of the input this far inside body A (cm) marks its corners: see input_sunk.
 INPUT_SUNK_CM = 0.1
+# Creases: a change of the angle between two neighbouring faces above this
+# (degrees). The dense dress's ripples along its side profiles on a heavier body
+# are 5-20 degrees between 0.1-0.3 cm faces (bench/README.md, "Creases").
+CREASE_DEGREES = 10.0
 
 
 def body_centre(body_vertices, y):
@@ -226,6 +230,14 @@ def score(case, original, faces, ids, body_a, body_b, dist_a, sunk_a, result, wa
     strain = np.abs(np.log(np.maximum(l1[ok], 1e-12) / l0[ok]))
     s["strain_p95"] = float(np.percentile(strain, 95))
     s["strain_max"] = float(strain.max())
+    # Creases: edges between two faces whose angle changed by more than
+    # CREASE_DEGREES from the input (a fold line, a groove, a crumple or a ripple
+    # along a curve; a smooth bend of the whole garment spreads small changes).
+    # Faces on welded vertices, so a soup's faces meet along their edges.
+    rep = np.empty(ids.max() + 1, dtype=np.int64)
+    rep[ids] = np.arange(len(ids))
+    welded = [[int(rep[ids[v]]) for v in f] for f in faces]
+    s["creases"] = int((meshes.dihedral_change(original, result, welded) > CREASE_DEGREES).sum())
     partners = meshes.mirror_partners(original)
     has = partners >= 0
     mirrored = result[has].copy()
@@ -400,9 +412,9 @@ def main():
         for case, rows in pool.map(lambda c: evaluate(args, c, out_dir), cases):
             results.append((case, rows))
 
-    print("| garment | body | method | flipped | inside v / faces | near-body change cm | strain p95 / max | "
+    print("| garment | body | method | flipped | inside v / faces | near-body change cm | strain p95 / max | creases | "
           "mirror cm | height ratio | features vs warp | between vs warp | hem spread cm | feature gap cm |")
-    print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     failures = {}
     dump = []
     for case, rows in results:
@@ -410,9 +422,9 @@ def main():
         v = verdicts(rows)
         for m, s in rows.items():
             gap = s.get("feature_gap")
-            print("| %s | %s | %s | %d | %d / %d | %.2f | %.3f / %.2f | %.2f | %.3f | %s | %s | %s | %s |" % (
+            print("| %s | %s | %s | %d | %d / %d | %.2f | %.3f / %.2f | %d | %.2f | %.3f | %s | %s | %s | %s |" % (
                 case.garment, case.target, m, s["flipped"], s["inside_vertices"], s["inside_faces"],
-                s["near_body_change"], s["strain_p95"], s["strain_max"], s["mirror"], s["height_ratio"],
+                s["near_body_change"], s["strain_p95"], s["strain_max"], s["creases"], s["mirror"], s["height_ratio"],
                 gains(s, w, "feature_errors") if m != "warp" else "", gains(s, w, "held_errors") if m != "warp" else "",
                 "%.2f" % s["hem_spread"] if "hem_spread" in s else "", "%.3f" % gap if gap is not None else ""))
             for k, ok in v[m].items():
@@ -456,6 +468,19 @@ def main():
         c = [s["near_body_change_input_clear"] for s in got]
         print("| %s | %.2f / %.2f | %d | %.2f / %.2f | %d |" % (m, max(a), float(np.median(a)), sum(x > 0.5 for x in a),
                                                         max(c), float(np.median(c)), sum(x > 0.5 for x in c)))
+    print()
+    print("Creases: edges whose two faces' angle changed by more than %g degrees from the input (worst / median" % CREASE_DEGREES)
+    print("over the cases), and the cases with more such edges than the warp's:")
+    print()
+    print("| method | creases | cases above the warp's |")
+    print("|---|---:|---:|")
+    for m in args.methods:
+        got = [(rows[m], rows.get("warp")) for _, rows in results if m in rows]
+        if not got:
+            continue
+        c = [s["creases"] for s, _ in got]
+        above = sum(1 for s, w in got if w is not None and s["creases"] > w["creases"]) if m != "warp" else 0
+        print("| %s | %d / %d | %s |" % (m, max(c), int(np.median(c)), above if m != "warp" else ""))
     print()
     print("Targets of issue 13 missed (cases):")
     methods = [m for m in args.methods if any(m in rows for _, rows in results)]
