@@ -354,12 +354,14 @@ def face_pairs(faces):
     return np.asarray([v for v in edges.values() if len(v) == 2], dtype=np.int64).reshape(-1, 2)
 
 
-def dihedral_change(original, result, faces):
-    """Per edge of face_pairs(faces), the change of the angle between its two faces'
-    normals from `original` to `result`, in degrees: a fold line or a groove the
-    result adds (a pinch) shows as a large change along a few edges, while a smooth
-    bend of a fine mesh spreads small ones."""
-    pairs = face_pairs(faces)
+def dihedral_change(original, result, faces, pairs=None):
+    """Per edge of face_pairs(faces) (or the `pairs` given, made by it once for
+    several results), the change of the angle between its two faces' normals from
+    `original` to `result`, in degrees: a fold line or a groove the result adds (a
+    pinch) shows as a large change along a few edges, while a smooth bend of a fine
+    mesh spreads small ones."""
+    if pairs is None:
+        pairs = face_pairs(faces)
     if len(pairs) == 0:
         return np.zeros(0)
 

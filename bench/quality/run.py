@@ -208,7 +208,8 @@ def input_sunk(original, faces, ids, body_a, depth=INPUT_SUNK_CM):
     return marked[ids]
 
 
-def score(case, original, faces, ids, body_a, body_b, dist_a, sunk_a, result, warp, curves, held, report):
+def score(case, original, faces, ids, crease_edges, body_a, body_b, dist_a, sunk_a, result, warp, curves, held,
+          report):
     s = {}
     s["flipped"] = meshes.flipped_faces(original, result, faces)
     dist_b = body_b.signed_distance(result)
@@ -233,11 +234,8 @@ def score(case, original, faces, ids, body_a, body_b, dist_a, sunk_a, result, wa
     # Creases: edges between two faces whose angle changed by more than
     # CREASE_DEGREES from the input (a fold line, a groove, a crumple or a ripple
     # along a curve; a smooth bend of the whole garment spreads small changes).
-    # Faces on welded vertices, so a soup's faces meet along their edges.
-    rep = np.empty(ids.max() + 1, dtype=np.int64)
-    rep[ids] = np.arange(len(ids))
-    welded = [[int(rep[ids[v]]) for v in f] for f in faces]
-    s["creases"] = int((meshes.dihedral_change(original, result, welded) > CREASE_DEGREES).sum())
+    welded, pairs = crease_edges
+    s["creases"] = int((meshes.dihedral_change(original, result, welded, pairs) > CREASE_DEGREES).sum())
     partners = meshes.mirror_partners(original)
     has = partners >= 0
     mirrored = result[has].copy()
@@ -292,6 +290,12 @@ def run_blender(case, out_dir):
 def evaluate(args, case, out_dir):
     original, faces = meshes.read_obj(case.garment_path)
     ids = meshes.weld_ids(original)
+    # The faces on welded vertices (a soup's faces meet along their edges) and
+    # their edges, for the creases of every method's result.
+    rep = np.empty(ids.max() + 1, dtype=np.int64)
+    rep[ids] = np.arange(len(ids))
+    welded = [[int(rep[ids[v]]) for v in f] for f in faces]
+    crease_edges = (welded, meshes.face_pairs(welded))
     body_a = meshes.Body(case.a_path)
     body_b = meshes.Body(case.b_path)
     dist_a = body_a.signed_distance(original)
@@ -321,7 +325,8 @@ def evaluate(args, case, out_dir):
         result = meshes.read_positions(path)
         if len(result) != len(original):
             raise RuntimeError("%s: %d vertices, expected %d" % (path, len(result), len(original)))
-        rows[method] = score(case, original, faces, ids, body_a, body_b, dist_a, sunk_a, result, warp, curves, held, report)
+        rows[method] = score(case, original, faces, ids, crease_edges, body_a, body_b, dist_a, sunk_a, result, warp,
+                             curves, held, report)
         if method == "warp":
             warp = rows[method]
     return case, rows
