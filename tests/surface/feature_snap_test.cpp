@@ -23,7 +23,7 @@ struct Sheet {
   std::vector<std::int32_t> feature_of;  // agent k is sample k
 };
 
-Sheet sheet() {
+Sheet sheet(double reach = kReach) {
   Sheet s;
   Garment& g = s.garment;
   g.positions.resize(kGridSide * kGridSide, 3);
@@ -48,8 +48,8 @@ Sheet sheet() {
     double sum = 0.0;
     for (int j = 0; j < m; ++j) {
       const double d2 = (row3(g.positions, v) - row3(s.samples, Index(j))).squaredNorm();
-      if (d2 >= kReach * kReach) continue;
-      const double t = 1.0 - d2 / (kReach * kReach);
+      if (d2 >= reach * reach) continue;
+      const double t = 1.0 - d2 / (reach * reach);
       row.push_back(Index(j));
       w.push_back(t * t);
       sum += t * t;
@@ -57,6 +57,18 @@ Sheet sheet() {
     s.reach.push_row(row);
     for (double x : w) s.weight.push_back(float(0.5 * x / sum));
   }
+  return s;
+}
+
+// The sheet's weights as the snap reach gives them: (1 - d^2/r^2)^2, not normalised.
+Sheet kernel_sheet(double reach) {
+  Sheet s = sheet(reach);
+  s.weight.clear();
+  for (Index v = 0; v < Index(s.garment.vertex_count()); ++v)
+    for (Index j : s.reach.row(v)) {
+      const double t = 1.0 - (row3(s.garment.positions, v) - row3(s.samples, j)).squaredNorm() / (reach * reach);
+      s.weight.push_back(float(t * t));
+    }
   return s;
 }
 
@@ -138,6 +150,55 @@ TEST(FeatureSnap, SamplesAlreadyOnTheirTargetsChangeNothing) {
   EXPECT_EQ(rep.gap_before, 0.0);
   EXPECT_EQ(rep.vertices_moved, 0u);
   EXPECT_EQ(std::memcmp(p.data(), s.garment.positions.data(), sizeof(double) * p.size()), 0);
+}
+
+TEST(FeatureSnap, TheNarrowedKernelIsTheSameKernelOnAShareOfTheRadius) {
+  SnapKernel k;
+  k.scale = {0.5, 1.0};
+  const auto w = [](double d) { return float((1.0 - d * d) * (1.0 - d * d)); };  // d in radii
+  EXPECT_NEAR(k.weight(w(0.3), 0), (1.0 - 0.09 / 0.25) * (1.0 - 0.09 / 0.25), 1e-6);
+  EXPECT_EQ(k.weight(w(0.6), 0), 0.0f);  // beyond half the radius
+  EXPECT_EQ(k.weight(w(0.6), 1), w(0.6));  // a whole kernel keeps its weights
+  EXPECT_EQ(k.weight(1.0f, 0), 1.0f);
+  EXPECT_EQ(SnapKernel{}.weight(w(0.6), 0), w(0.6));
+}
+
+TEST(FeatureSnap, OnlyAKernelWideAgainstItsFacesIsNarrowed) {
+  // Faces 1 wide: a sample's farthest corner (of those it has weight on) lies
+  // 0.7 to 1.2 from its agent. A kernel of radius 2 is kept whole (three times
+  // that corner is beyond it), one of radius 12.5 is narrowed to the share asked.
+  for (const double reach : {2.0, 12.5}) {
+    const Sheet s = kernel_sheet(reach);
+    SnapVertices vs;
+    for (const auto& corners : s.at.vertex)
+      for (Index v : corners) {
+        SnapVertex& sv = vs[v];
+        sv.position = row3(s.garment.positions, v);
+        const auto r = s.reach.row(v);
+        sv.reach.assign(r.begin(), r.end());
+        sv.weight.assign(s.weight.begin() + s.reach.offsets[v], s.weight.begin() + s.reach.offsets[v + 1]);
+      }
+    const SnapKernel k = narrowed_kernel(s.at, vs, s.feature_of, 0.5);
+    ASSERT_EQ(k.scale.size(), s.at.vertex.size());
+    for (double q : k.scale) {
+      if (reach < 5.0) EXPECT_EQ(q, 1.0) << reach;
+      else EXPECT_EQ(q, 0.5) << reach;
+    }
+    EXPECT_TRUE(narrowed_kernel(s.at, vs, s.feature_of, 1.0).scale.empty());
+  }
+}
+
+TEST(FeatureSnap, NarrowedLaterPassesStillReachTheTargets) {
+  // A wide kernel on fine faces (the case the narrowing is for): the passes
+  // after the first on half the radius close what the first leaves.
+  const Sheet s = kernel_sheet(12.5);
+  const Points targets = lifted(s.samples);
+  Points p = s.garment.positions;
+  const FeatureSnapReport first = snap_to_features(p, targets, s.at, s.reach, s.weight, s.feature_of, {}, 1e-3);
+  const FeatureSnapReport second = snap_to_features(p, targets, s.at, s.reach, s.weight, s.feature_of, {}, 1e-3, 0.5);
+  std::printf("  gap %.5f -> %.6f (whole kernel) -> %.8f (narrowed)\n", first.gap_before, first.gap_after, second.gap_after);
+  EXPECT_LT(second.gap_after, 0.5 * first.gap_after);
+  EXPECT_LT((carry(s.at, p) - targets).rowwise().norm().maxCoeff(), second.gap_after + 1e-12);
 }
 
 }  // namespace

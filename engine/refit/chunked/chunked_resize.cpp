@@ -339,7 +339,7 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
         // apply_feature_snap adds them), in passes as SurfaceBinding::snap: a pass
         // that would not lower the gap is not applied; the sample vertices move
         // by each pass as the garment's do.
-        const auto apply_pass = [&](const FeatureSnap& snap, PointFile& file) {
+        const auto apply_pass = [&](const FeatureSnap& snap, const SnapKernel& kernel, PointFile& file) {
           std::vector<SnapTerm> batch;
           std::size_t next = 0, taken = 0, moved = 0;
           Index previous = std::numeric_limits<Index>::max();
@@ -355,7 +355,7 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
               }
               const SnapTerm& t = batch[taken];
               if (t.vertex >= end) break;
-              s.row(Eigen::Index(t.vertex - first)) += double(t.weight) * snap.correction.row(t.feature);
+              s.row(Eigen::Index(t.vertex - first)) += double(kernel.weight(t.weight, t.feature)) * snap.correction.row(t.feature);
               moved += t.vertex != previous;
               previous = t.vertex;
               ++taken;
@@ -366,7 +366,7 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
             if (sv.held || sv.weight.empty()) continue;
             for (std::size_t q = 0; q < sv.reach.size(); ++q) {
               const std::int32_t f = surface.feature_of()[sv.reach[q]];
-              if (f >= 0) sv.position += double(sv.weight[q]) * snap.correction.row(f).transpose();
+              if (f >= 0) sv.position += double(kernel.weight(sv.weight[q], f)) * snap.correction.row(f).transpose();
             }
           }
           return moved;
@@ -374,10 +374,16 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
         snap_in_passes = [&, apply_pass](PointFile& file) {
           FeatureSnapReport total;
           const int passes = std::max(1, surface.options().snap_passes);
+          const bool kernel_reach = surface.options().snap_radius > 0.0;
           for (int pass = 0; pass < passes; ++pass) {
+            // As SurfaceBinding::snap: the passes after the first on the narrowed kernel.
+            const SnapKernel kernel =
+                kernel_reach && pass > 0
+                    ? narrowed_kernel(at, snap_vertices, surface.feature_of(), surface.options().snap_remainder_share)
+                    : SnapKernel{};
             FeatureSnap snap = solve_feature_snap(feature_targets, at, snap_vertices, surface.feature_of(), any_weight,
-                                                  surface.options().snap_regularisation);
-            snap.report.gap_after = snapped_gap(snap, feature_targets, at, snap_vertices, surface.feature_of());
+                                                  surface.options().snap_regularisation, kernel);
+            snap.report.gap_after = snapped_gap(snap, feature_targets, at, snap_vertices, surface.feature_of(), kernel);
             if (pass == 0) total = snap.report;
             total.gap_after = snap.report.gap_after;
             if (!(snap.report.gap_after < snap.report.gap_before)) {
@@ -385,7 +391,7 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
               break;
             }
             if (snap.correction.size() > 0 && snap_count > 0) {
-              const std::size_t moved = apply_pass(snap, file);
+              const std::size_t moved = apply_pass(snap, kernel, file);
               if (pass == 0) total.vertices_moved = moved;
             }
           }

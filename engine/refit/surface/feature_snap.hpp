@@ -13,6 +13,13 @@
 // least-squares problem (one row per feature sample, Tikhonov-regularised) so
 // the carried samples reach their targets. The correction is smooth (it fades
 // with w) and zero where the reconstruction already hit the targets (A = B).
+//
+// The passes after the first fit what the first leaves, which varies from sample
+// to sample; spread over the whole kernel those small corrections alternate from
+// sample to sample and show as diamonds on a fine mesh (the 1M dress: a pattern
+// 1.5 cm wide beside each side profile). They take a kernel narrowed to a share
+// of the radius (SnapKernel), never so narrow that it misses the corners of its
+// own sample's face.
 #include <refit/attach/attachment.hpp>
 #include <refit/core/types.hpp>
 
@@ -40,6 +47,20 @@ struct SnapVertex {
 /// Every vertex of the attachment (all three of each sample, weight 0 too), by vertex.
 using SnapVertices = std::unordered_map<Index, SnapVertex>;
 
+/// The weights a pass uses: the reach's own, or each feature agent's narrowed
+/// to a share of the radius (`scale`, per feature sample: empty, the reach's own).
+struct SnapKernel {
+  std::vector<double> scale;
+  float weight(float w, std::int32_t feature) const;
+};
+
+/// The narrowed kernel of the passes after the first: per feature sample, the
+/// share of the radius its agent keeps, `share` or more where the farthest
+/// corner of the sample's face (read off its weight there, (1 - d^2/r^2)^2)
+/// needs it (1: a corner out of reach).
+SnapKernel narrowed_kernel(const SurfaceAttachment& attachment, const SnapVertices& vertices,
+                           const std::vector<std::int32_t>& feature_of, double share);
+
 /// The snap's solution: a correction per feature agent (its sample's row), nf x 3.
 struct FeatureSnap {
   Eigen::MatrixXd correction;  // empty: nothing to correct
@@ -49,28 +70,30 @@ struct FeatureSnap {
 /// The corrections that carry the samples to `targets` (see above), from the
 /// sample vertices alone; report.gap_after and vertices_moved are left to the caller.
 FeatureSnap solve_feature_snap(const Points& targets, const SurfaceAttachment& attachment, const SnapVertices& vertices,
-                               const std::vector<std::int32_t>& feature_of, bool blend_weights, double regularisation);
+                               const std::vector<std::int32_t>& feature_of, bool blend_weights, double regularisation,
+                               const SnapKernel& kernel = {});
 
 /// Moves rows of `positions` (all vertices or a chunk; `reach`, `reach_weight`
 /// and `held` theirs) by the corrections; returns how many moved.
 std::size_t apply_feature_snap(const FeatureSnap& snap, Points& positions, const Csr& reach,
                                const std::vector<float>& reach_weight, const std::vector<std::int32_t>& feature_of,
-                               std::span<const std::uint8_t> held);
+                               std::span<const std::uint8_t> held, const SnapKernel& kernel = {});
 
 /// Largest distance from a carried sample to its target over the samples not
 /// on a held vertex, with the sample vertices moved by the corrections.
 double snapped_gap(const FeatureSnap& snap, const Points& targets, const SurfaceAttachment& attachment,
-                   const SnapVertices& vertices, const std::vector<std::int32_t>& feature_of);
+                   const SnapVertices& vertices, const std::vector<std::int32_t>& feature_of, const SnapKernel& kernel = {});
 
 /// Corrects `positions` (every garment vertex) so that the feature samples
 /// attached by `attachment` reach `targets`. `reach`/`reach_weight`: each
 /// vertex's agents and their weights (the snap reach or the blends, above); `feature_of`: per agent, its
 /// feature sample or -1; `held`: vertices that must not move (empty: none).
 /// `regularisation`: Tikhonov weight relative to the mean diagonal of the
-/// normal equations. Deterministic for any thread count.
+/// normal equations. `narrow`: the kernel narrowed to this share (narrowed_kernel;
+/// 1: the weights as given). Deterministic for any thread count.
 FeatureSnapReport snap_to_features(Points& positions, const Points& targets, const SurfaceAttachment& attachment,
                                    const Csr& reach, const std::vector<float>& reach_weight,
                                    const std::vector<std::int32_t>& feature_of, const std::vector<std::uint8_t>& held,
-                                   double regularisation);
+                                   double regularisation, double narrow = 1.0);
 
 }  // namespace refit

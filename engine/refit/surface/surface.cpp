@@ -445,8 +445,9 @@ FeatureSnapReport SurfaceBinding::snap(Points& positions, const Points& targets,
   const std::vector<float>& weight = kernel ? snap_reach_.weight : blends_.weight;
   for (int pass = 0; pass < std::max(1, passes > 0 ? passes : options_.snap_passes); ++pass) {
     const Points before = positions;
-    const FeatureSnapReport r = snap_to_features(positions, targets, feature_attachment_, reach, weight, feature_of_,
-                                                 held, options_.snap_regularisation);
+    const FeatureSnapReport r =
+        snap_to_features(positions, targets, feature_attachment_, reach, weight, feature_of_, held,
+                         options_.snap_regularisation, kernel && pass > 0 ? options_.snap_remainder_share : 1.0);
     if (pass == 0) total = r;  // every pass moves the same vertices
     total.gap_after = r.gap_after;
     if (!(r.gap_after < r.gap_before)) {  // a pass that does not help is undone

@@ -71,6 +71,9 @@ struct SurfaceOptions {
   double snap_regularisation = 1e-4;  // Tikhonov weight of that correction, relative to its normal equations' diagonal
   int snap_passes = 4;             // the correction repeated on what is left (each pass removes most of the rest where
                                    // the samples do not conflict; the regularisation keeps one pass from overshooting)
+  double snap_remainder_share = 0.5;  // the passes after the first reach this share of snap_radius only (at least the
+                                   // corners of each sample's face): spread over the whole radius, what the first
+                                   // leaves alternates from sample to sample (diamonds on a fine mesh); 1: every pass alike
   bool keep_clear_of_body = true;  // free agents the solve leaves closer than `clearance` to body B (or inside) are held
                                    // at that clearance and the system is solved again (see apply; false: the paper)
   double clearance = 0.4;          // garment units (the pipeline passes twice its collision clearance, so vertices
