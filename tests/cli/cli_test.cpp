@@ -137,6 +137,23 @@ TEST(Cli, PaperVariantsRunAndChangeTheResult) {
   }
 }
 
+TEST(Cli, SnapRemainderReachesTheSnap) {
+  // The demo dress's faces are fine against the snap's kernel, so the later
+  // passes' narrowed kernel (the default, 0.5) gives another garment than the
+  // whole kernel (1); both pass through the curves.
+  const Case c;
+  const std::string feats = "--features '" + c.features + "' ";
+  const std::string half = c.dir.file("half.obj"), whole = c.dir.file("whole.obj");
+  const std::string half_report = c.dir.file("half.json"), whole_report = c.dir.file("whole.json");
+  ASSERT_EQ(run_cli(c.resize(half, feats + "--report '" + half_report + "'")).exit_code, 0);
+  ASSERT_EQ(run_cli(c.resize(whole, feats + "--snap-remainder 1 --report '" + whole_report + "'")).exit_code, 0);
+  EXPECT_NE(test::read_text(half), test::read_text(whole));
+  for (const std::string& r : {half_report, whole_report}) {
+    const auto report = nlohmann::json::parse(test::read_text(r));
+    EXPECT_LT(report.at("surface").at("feature_gap").get<double>(), 0.05) << r;
+  }
+}
+
 TEST(Cli, MethodPaperIsEveryPaperSwitchAtOnce) {
   // The profile is a name for the switches, not a code path of its own: the same
   // bytes as all of them given one by one, and an explicit --symmetry still wins.
@@ -235,7 +252,9 @@ TEST(Cli, UsageErrorsExitTwoAndHelpDocumentsExitCodes) {
                                  "resize --garment g.obj --from a.obj --to b.obj --out o.obj --units furlong",
                                  "resize --garment g.obj --from a.obj --to b.obj --out o.obj --clearance nan",
                                  "resize --garment g.obj --from a.obj --to b.obj --out o.obj --clearance inf",
-                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --clearance 1e6"}) {
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --clearance 1e6",
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --snap-remainder 0",
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --snap-remainder 1.5"}) {
     SCOPED_TRACE(args);
     EXPECT_EQ(run_cli(args).exit_code, 2);
   }

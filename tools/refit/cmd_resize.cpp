@@ -415,6 +415,13 @@ const Register resize_command("resize", "Resize a garment from body A to one or 
       ->capture_default_str()
       ->check(CLI::Range(0.0, 16.0))
       ->group(kAdvanced);
+  app.add_option("--snap-remainder", a->surface.snap_remainder_share,
+                 "The snap's passes after the first reach this share of --snap-radius only (at least three times the "
+                 "farthest corner of each sample's face; 1 = every pass the whole radius, as before 2026-11-29: on a "
+                 "fine mesh that alternates along the curve)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.01, 1.0))
+      ->group(kAdvanced);
   app.add_option("--feature-bend", a->surface.feature_bend_radius,
                  "Within about this distance of a feature (cm) the surface is solved again so that it leaves the "
                  "feature with the feature's slope instead of a crease (0 = off: the paper's eq. 13 alone; docs/method.md)")
