@@ -374,13 +374,8 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
         snap_in_passes = [&, apply_pass](PointFile& file) {
           FeatureSnapReport total;
           const int passes = std::max(1, surface.options().snap_passes);
-          const bool kernel_reach = surface.options().snap_radius > 0.0;
           for (int pass = 0; pass < passes; ++pass) {
-            // As SurfaceBinding::snap: the passes after the first on the narrowed kernel.
-            const SnapKernel kernel =
-                kernel_reach && pass > 0
-                    ? narrowed_kernel(at, snap_vertices, surface.feature_of(), surface.options().snap_remainder_share)
-                    : SnapKernel{};
+            const SnapKernel kernel = narrowed_kernel(at, snap_vertices, surface.feature_of(), surface.snap_share(pass));
             FeatureSnap snap = solve_feature_snap(feature_targets, at, snap_vertices, surface.feature_of(), any_weight,
                                                   surface.options().snap_regularisation, kernel);
             snap.report.gap_after = snapped_gap(snap, feature_targets, at, snap_vertices, surface.feature_of(), kernel);

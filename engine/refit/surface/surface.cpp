@@ -447,7 +447,7 @@ FeatureSnapReport SurfaceBinding::snap(Points& positions, const Points& targets,
     const Points before = positions;
     const FeatureSnapReport r =
         snap_to_features(positions, targets, feature_attachment_, reach, weight, feature_of_, held,
-                         options_.snap_regularisation, kernel && pass > 0 ? options_.snap_remainder_share : 1.0);
+                         options_.snap_regularisation, snap_share(pass));
     if (pass == 0) total = r;  // every pass moves the same vertices
     total.gap_after = r.gap_after;
     if (!(r.gap_after < r.gap_before)) {  // a pass that does not help is undone

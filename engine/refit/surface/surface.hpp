@@ -293,6 +293,11 @@ class SurfaceBinding {
   NearBody near_body(const BodySurface& body_b) const;
   /// Whether the snap to the features runs (snap_to_features, feature_snap.hpp).
   bool snaps() const;
+  /// The share of the snap's radius pass `pass` reaches (snap_remainder_share after
+  /// the first pass with the snap's own reach; 1 otherwise), for apply and the chunked mode.
+  double snap_share(int pass) const {
+    return options_.snap_radius > 0.0 && pass > 0 ? options_.snap_remainder_share : 1.0;
+  }
   const std::vector<std::int32_t>& feature_of() const { return feature_of_; }
   const SurfaceAttachment& feature_attachment() const { return feature_attachment_; }
 
