@@ -1,6 +1,7 @@
 // `refit resize`: one garment, body A, one or many bodies B. Binds once, then
 // resizes to each body; every output file is written atomically.
 #include "command.hpp"
+#include "heap.hpp"
 #include "manifest.hpp"
 #include "patterns_output.hpp"
 #include "report_file.hpp"
@@ -280,9 +281,11 @@ int run(ResizeArgs a) {
     size = {obj->bytes(), obj->vertex_count(), obj->face_count()};
   }
   const SurfaceOptions so = surface_options_in_units(options);
-  const double in_memory_mb =
-      estimated_memory_mb(size.vertices, options.stage == Stage::Full ? estimated_agents(size.vertices, so.agent_budget, so.voxel) : 0.0,
-                          body_a.triangles.size());
+  const auto estimate_mb = [&, triangles = body_a.triangles.size()](std::size_t vertices) {
+    return estimated_memory_mb(
+        vertices, options.stage == Stage::Full ? estimated_agents(vertices, so.agent_budget, so.voxel) : 0.0, triangles);
+  };
+  const double in_memory_mb = estimate_mb(size.vertices);
   if (obj && use_chunks(size, chunking, in_memory_mb)) {
     try {
       check_chunked_options(options);
@@ -321,6 +324,8 @@ int run(ResizeArgs a) {
   // it was the largest single part of a dense garment's peak memory (bench/README.md).
   auto garment = std::make_shared<const Garment>(read_garment_obj(a.garment, SourceText::released));
   run.load_ms = clock.ms();
+  // The heap grown to the run's estimated peak at once, on every thread (heap.hpp).
+  grow_heap_for_run(std::size_t(estimate_mb(garment->vertex_count()) * 1024.0 * 1024.0));
   run.garment = garment_summary(*garment);
   run.garment_warnings = garment->source ? garment->source->warnings : std::vector<std::string>{};
   for (const auto& w : run.garment_warnings) std::fprintf(stderr, "refit: warning: %s\n", w.c_str());

@@ -1,11 +1,11 @@
 // `refit`: the command line. Every error reaches the user as one line on stderr
 // and a non-zero exit; commands write their outputs atomically.
 #include "command.hpp"
+#include "heap.hpp"
 
 #include <refit/core/error.hpp>
 #include <refit/io/atomic_file.hpp>
 
-#include <malloc.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,7 +13,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
-#include <limits>
 #include <string>
 
 namespace refit::cli {
@@ -56,24 +55,11 @@ void run_on_huge_pages(char** argv) {
   if (tunables) setenv("GLIBC_TUNABLES", tunables, 1);
 }
 
-// Freed buffers kept for the next ones instead of handed back to the system.
-// glibc maps every block above its mmap threshold (128 KB, rising with use) on
-// its own and unmaps it on free, and trims the heap's top, so each stage's
-// vectors of a million rows first-touch fresh pages again, each zeroed by the
-// kernel. Blocks up to 32 MB (glibc's largest threshold: a million rows of 3
-// doubles is 24 MB) now come from the heap, which is not trimmed. Measured on
-// the dense 1M dress (bench/README.md, "Freed memory kept"): minor faults 29k
-// -> 15k, system time 1.9 -> 1.1 s.
-void keep_freed_memory() {
-  mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
-  mallopt(M_TRIM_THRESHOLD, std::numeric_limits<int>::max());
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   run_on_huge_pages(argv);
-  keep_freed_memory();
+  refit::cli::keep_freed_memory();
   using namespace refit::cli;
   CLI::App app{"refit: resize 3D garments to new bodies while keeping their designed shape"};
   app.require_subcommand(1);
