@@ -9,7 +9,8 @@ namespace refit::cli {
 /// (see heap.cpp). Call once, before anything large is allocated.
 void keep_freed_memory();
 
-/// For a garment resized in memory, whose peak is estimated at `peak_bytes`:
+/// For a garment resized in memory by the whole pipeline, whose peak is
+/// estimated at `peak_bytes` (a run's true peak, not a bound far above it):
 /// blocks of any size come from the heap, and when the run is large the heap
 /// is grown to the estimate at once, its new memory first-touched by all worker
 /// threads, then freed for the run to reuse. On a virtual machine a first touch
