@@ -1,7 +1,8 @@
 // All feature curves in one solve (ShapeMatchingOptions::joint), on hand-made
 // crossing curves: meeting samples coincide, each curve keeps its shape, a
 // similarity of the body moves every curve by that similarity, curves end clear
-// of body B, a one-sided profile and its mirror meet the hem like the others.
+// of body B, a one-sided profile and its mirror meet the hem like the others,
+// a curve the solve sinks into body B is placed clear of it before it is bent.
 #include <refit/core/error.hpp>
 #include <refit/features/bspline.hpp>
 #include <refit/features/shape_matching.hpp>
@@ -16,6 +17,7 @@
 #include <span>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <numbers>
 
 using namespace refit;
@@ -325,4 +327,65 @@ TEST(JointMatching, SamplesThatSatOnBodyAFollowBodyB) {
   // The part that never sat on the body keeps its shape: the rising end stays straight.
   const Vec3 a = row3(followed.optimised, 30), b = row3(followed.optimised, 35), c = row3(followed.optimised, 40);
   EXPECT_LT((b - 0.5 * (a + c)).norm(), 0.02);
+}
+
+namespace {
+
+// A straight curve `height` above body B's floor y = 0.05 x^2, which the warp
+// follows (it bends the curve's samples onto the parabola `height` above it).
+// The solve straightens the curve, and parts of the straight line sink into the
+// floor; a move of the whole line clears it.
+CurveResult straightened_over_a_bowl(double height, double band) {
+  Points s(41, 3);
+  for (int i = 0; i < 41; ++i) s.row(i) << -10.0 + 0.5 * i, height, 0.0;
+  const std::vector<FeatureCurve> curves = {
+      make_feature_curve("A", s, false, FeaturePlane::from_point_normal(Vec3::Zero(), Vec3::UnitZ()), {}, 0)};
+  const auto floor_y = [](double x) { return 0.05 * x * x; };
+  const auto warp = [&](const Vec3& p) { return Vec3(p.x(), p.y() + floor_y(p.x()), p.z()); };
+  const auto distance = [&](const Vec3& p) { return p.y() - floor_y(p.x()); };
+  const ClearanceToBody floor = [&](const Vec3& p, double clearance) {
+    return ClearanceNeed{Vec3::UnitY(), clearance - distance(p)};
+  };
+  ShapeMatchingOptions o;
+  o.clearance = 0.25;
+  o.placement_band = band;
+  o.placement_near = 1.0;
+  std::vector<Points> ws, wa;
+  for (const FeatureCurve& c : curves) {
+    ws.push_back(map_rows(c.samples, warp));
+    wa.push_back(map_rows(c.aux, warp));
+  }
+  return match_shapes(prepare_shape_model(curves, o), ws, wa, distance, floor).curves[0];
+}
+
+double lowest_over_floor(const CurveResult& c) {
+  double low = std::numeric_limits<double>::infinity();
+  for (Eigen::Index i = 0; i < c.optimised.rows(); ++i)
+    low = std::min(low, c.optimised(i, 1) - 0.05 * c.optimised(i, 0) * c.optimised(i, 0));
+  return low;
+}
+
+}  // namespace
+
+TEST(JointMatching, ACurveTheSolveSinksIntoBodyBIsPlacedClearBeforeItBends) {
+  const CurveResult bent = straightened_over_a_bowl(2.0, -1.0), placed = straightened_over_a_bowl(2.0, 0.3);
+  std::printf("[ info ] straightened over a bowl: shape error bent %.6f (cleared %zu, placed %.3f), placed %.6f "
+              "(cleared %zu, placed %.3f)\n",
+              bent.shape_error_result, bent.cleared.size(), bent.placed, placed.shape_error_result,
+              placed.cleared.size(), placed.placed);
+  ASSERT_FALSE(bent.cleared.empty());  // the test means something: without the placement the curve is bent
+  EXPECT_EQ(bent.placed, 0.0);
+  EXPECT_GT(placed.placed, 0.0);
+  for (const CurveResult* c : {&bent, &placed}) EXPECT_GE(lowest_over_floor(*c), 0.25 - 1e-3);
+  EXPECT_LT(placed.shape_error_result, 0.2 * bent.shape_error_result);
+}
+
+TEST(JointMatching, APlacementThatStandsTheCurveOffWhereItSatOnTheBodyIsNotKept) {
+  // 0.5 above the floor: it sat on body A, and clearing the line as a whole would
+  // stand its middle off by more than the band: the curve is bent as without it.
+  const CurveResult bent = straightened_over_a_bowl(0.5, -1.0), refused = straightened_over_a_bowl(0.5, 0.3);
+  ASSERT_FALSE(bent.cleared.empty());
+  ASSERT_GT(straightened_over_a_bowl(0.5, 10.0).placed, 0.0);  // the band is what refuses it
+  EXPECT_EQ(refused.placed, 0.0);
+  EXPECT_EQ((refused.optimised - bent.optimised).cwiseAbs().maxCoeff(), 0.0);
 }

@@ -271,6 +271,92 @@ std::vector<Vec3> spread_moves(const ShapeModel& model, const std::vector<std::v
   return moved;
 }
 
+// The placement step of match_shapes_jointly (see there): a curve's own samples
+// (`slots`, in its plane) turned and scaled about `pivot`, and moved in the plane
+// as well when `free`, by least squares on what each still needs to clear body B
+// (a little regularisation keeps the move small); over rounds, as samples come
+// to need it. Samples needing more than `threshold` are cleared; those the warp
+// left within `near` of body B are held to `band` farther off than the warp put
+// them. Returns how far a sample moved, or 0 when the move is not kept (see
+// ShapeMatchingOptions::placement_band) and the curve is as it was.
+template <class Need>
+double place_clear(const std::vector<std::size_t>& slots, const std::vector<double>& warped_distance,
+                   const std::vector<double>& clearance, const FeaturePlane& plane, const Vec3& pivot, bool free,
+                   double near, double band, double threshold, JointSystem& sys, const Need& need_of) {
+  constexpr double kRegularisation = 0.01;
+  constexpr int kRounds = 8;
+  const std::size_t n = slots.size();
+  const Vec3 normal = plane.normal.normalized();
+  const int unknowns = free ? 4 : 2;
+  std::vector<Vec3> start(n);
+  for (std::size_t j = 0; j < n; ++j) start[j] = sys.slot(slots[j]);
+  // The move's columns at p: a turn about the plane's normal, a scale, in-plane moves.
+  const auto columns = [&](const Vec3& p) {
+    const Vec3 d = p - pivot;
+    return std::array<Vec3, 4>{normal.cross(d), d, plane.axis_u, plane.axis_v};
+  };
+  const auto distance = [&](std::size_t j, const ClearanceNeed& need) { return clearance[j] - need.amount; };
+  const auto farthest = [&](std::size_t j) { return std::max(warped_distance[j] + band, clearance[j]); };
+  double needed = 0.0, most = 0.0;
+  std::vector<std::uint8_t> clearing(n, 0);
+  for (int round = 0; round < kRounds; ++round) {
+    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(Eigen::Index(3 * n), unknowns);
+    Eigen::VectorXd b = Eigen::VectorXd::Zero(Eigen::Index(3 * n));
+    Eigen::Index rows = 0;
+    bool any = false;
+    for (std::size_t j = 0; j < n; ++j) {
+      const Vec3 p = sys.slot(slots[j]);
+      const ClearanceNeed need = need_of(j, p);
+      const std::array<Vec3, 4> col = columns(p);
+      if (round == 0) needed = std::max(needed, need.amount);
+      if (need.amount > threshold) {
+        clearing[j] = 1;
+        most = std::max(most, need.amount);
+      }
+      double target = 0.0;
+      bool row = false;
+      if (clearing[j]) {
+        target = std::max(need.amount, 0.0);
+        row = any = true;
+      } else if (warped_distance[j] <= near && distance(j, need) > farthest(j)) {
+        target = farthest(j) - distance(j, need);  // back towards the body
+        row = true;
+      }
+      if (row) {
+        for (int q = 0; q < unknowns; ++q) a(rows, q) = need.direction.dot(col[std::size_t(q)]);
+        b(rows++) = target;
+      }
+      for (const Vec3& axis : {plane.axis_u, plane.axis_v}) {
+        for (int q = 0; q < unknowns; ++q) a(rows, q) = std::sqrt(kRegularisation) * axis.dot(col[std::size_t(q)]);
+        ++rows;
+      }
+    }
+    if (!any) break;
+    const Eigen::VectorXd x = a.topRows(rows).colPivHouseholderQr().solve(b.head(rows));
+    for (std::size_t j = 0; j < n; ++j) {
+      const std::array<Vec3, 4> col = columns(sys.slot(slots[j]));
+      Vec3 move = Vec3::Zero();
+      for (int q = 0; q < unknowns; ++q) move += x(q) * col[std::size_t(q)];
+      sys.slot(slots[j]) += move;
+    }
+  }
+  double moved = 0.0, left = 0.0, beyond = 0.0;
+  for (std::size_t j = 0; j < n; ++j) {
+    const Vec3 p = sys.slot(slots[j]);
+    moved = std::max(moved, (p - start[j]).norm());
+    const ClearanceNeed need = need_of(j, p);
+    left = std::max(left, need.amount);
+    if (warped_distance[j] <= near) beyond = std::max(beyond, distance(j, need) - farthest(j));
+  }
+  // Kept when it takes at least half of the bend away, stands no near sample off
+  // beyond the band, and did not swing the curve (a move over three times the need).
+  constexpr double kBandTolerance = 1.0 / 6.0;  // of the band: what the least squares leaves
+  const bool kept = needed > 0.0 && left <= 0.5 * needed && beyond <= kBandTolerance * band && moved <= 3.0 * most;
+  if (!kept)
+    for (std::size_t j = 0; j < n; ++j) sys.slot(slots[j]) = start[j];
+  return kept ? moved : 0.0;
+}
+
 }  // namespace
 
 FeatureResult match_shapes_jointly(const ShapeModel& model, const std::vector<Points>& warped_samples,
@@ -483,6 +569,37 @@ FeatureResult match_shapes_jointly(const ShapeModel& model, const std::vector<Po
     };
     pulled_by = spread_moves(model, expr, sys, pull, o.clearance_rounds);
   }
+  // Placement: a curve the solve leaves too close to body B is first turned and
+  // scaled (about where it meets an earlier curve) to clear it as a whole, so the
+  // bend below has less to do (issue 13: the feature profiles keep their shape;
+  // bench/README.md, "Are the remaining shape misses reachable?").
+  std::vector<double> placed(count, 0.0);
+  if (clear && o.placement_band >= 0.0)
+    for (std::size_t k = 0; k < count; ++k) {
+      const std::size_t m = model.curves[k].size();
+      if (model.crossings[k].size() > 1) continue;  // pinned at two points: only a bend
+      std::vector<std::size_t> slots;
+      std::vector<double> near_distance, clearance;
+      for (std::size_t i = 0; i < m; ++i)
+        if (!crossing[k][i] && expr[k][i].terms.size() == 1 && expr[k][i].terms[0].second == 1.0 &&
+            expr[k][i].constant.isZero()) {
+          slots.push_back(expr[k][i].terms[0].first);
+          near_distance.push_back(warped_distance[k][i]);
+          clearance.push_back(clearance_of(k, i));
+        }
+      if (slots.size() < 3) continue;
+      const bool free = model.crossings[k].empty();
+      Vec3 pivot = Vec3::Zero();
+      if (free) {
+        for (const std::size_t s : slots) pivot += sys.slot(s);
+        pivot /= double(slots.size());
+      } else {
+        pivot = sys.eval(expr[k][model.crossings[k][0].sample]);
+      }
+      placed[k] = place_clear(slots, near_distance, clearance, frame[k].plane, pivot, free, o.placement_near,
+                              o.placement_band, 1e-3 * o.clearance, sys,
+                              [&](std::size_t j, const Vec3& p) { return clearance_to_body_b(p, clearance[j]); });
+    }
   if (clear) {
     const auto push = [&](std::size_t k, std::size_t i, const Vec3& p) {
       const ClearanceNeed need = clearance_to_body_b(p, clearance_of(k, i));
@@ -510,6 +627,7 @@ FeatureResult match_shapes_jointly(const ShapeModel& model, const std::vector<Po
       return out;
     };
     r.cleared = moved_samples(moved_by, "clearance");
+    r.placed = placed[k];
     r.followed = moved_samples(pulled_by, "follow");
     Coords xw(Eigen::Index(m), 2), x(Eigen::Index(m), 2);
     for (std::size_t i = 0; i < m; ++i) {

@@ -85,6 +85,15 @@ struct ShapeMatchingOptions {
   /// body A it follows body B.
   double follow_body = 0.0;
   double follow_tolerance = 0.0;  // garment units
+  /// Joint solve with a clearance: before a curve is bent clear of body B, it is
+  /// turned and scaled in its plane about the point where it meets an earlier
+  /// curve (or moved, turned and scaled in its plane when it meets none) to clear
+  /// the body as a whole. Kept when that takes at least half of the bend away and
+  /// no sample the warp left within placement_near of body B ends more than
+  /// placement_band farther off than the warp put it (garment units; < 0: off).
+  /// The pipeline passes the surface's near-body band (0.3 cm) and 1 cm.
+  double placement_band = -1.0;
+  double placement_near = 0.0;
   /// Joint solve: a curve whose plane lies within this many degrees of level on
   /// body A (its normal along body A's long axis: a hem, a waistline) keeps its
   /// plane level on body B instead of taking the warp's tilt; 0: off.
@@ -153,6 +162,7 @@ struct CurveResult {
   std::vector<FixedSample> crossings;  // samples on an earlier curve (in order: fixed where it put them; joint: shared)
   std::vector<FixedSample> cleared;    // joint: samples held at the clearance from body B (distance: how far they moved)
   std::vector<FixedSample> followed;   // joint: samples pulled back towards body B (distance: how far they moved)
+  double placed = 0.0;                 // joint: how far the placement before the clearance bend moved a sample (largest)
   bool level = false;                  // joint: its plane kept level (ShapeModel::level)
   double energy_warped = 0.0, energy_result = 0.0;  // eq. 9 (weights as applied) at the projected warped samples and at the result
   double shape_error_warped = 0.0, shape_error_result = 0.0;  // see curve_metrics.hpp

@@ -170,6 +170,13 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
     // The curves end clear of body B by the collision clearance and a margin, so
     // the collision step finds nothing to move on them (issue 13: the written garment follows the curves).
     if (options_.collision && sm.clearance <= 0.0) sm.clearance = (options_.clearance_cm + kFeatureClearanceMarginCm) * per_cm;
+    // A curve the solve sinks into body B is first placed clear of it as a whole,
+    // holding what sat on body A to the surface step's near-body band (none with
+    // --near-body-band 0, the paper's eq. 14).
+    if (options_.collision && sm.placement_band < 0.0 && options_.surface.near_body_band > 0.0) {
+      sm.placement_band = options_.surface.near_body_band * per_cm;
+      sm.placement_near = kFeatureNearBodyCm * per_cm;
+    }
     // Where a curve sat on body A it follows body B (issue 13: vertices that sat on body A follow body B).
     if (options_.collision && sm.follow_body <= 0.0 && options_.follow_body_cm > 0.0) {
       sm.follow_body = options_.follow_body_cm * per_cm;

@@ -167,6 +167,8 @@ inline constexpr const char* kVersion = "0.1.0";
 /// With the collision step on, the joint feature solve keeps the curves this much
 /// farther from body B than the collision clearance (ShapeMatchingOptions::clearance 0).
 inline constexpr double kFeatureClearanceMarginCm = 0.05;
+/// A feature sample the warp leaves this close to body B sat on body A (the quality suite's near-body distance).
+inline constexpr double kFeatureNearBodyCm = 1.0;
 /// The most a feature sample stands farther off body B for a face under it that dips (dipping_face_clearance).
 inline constexpr double kDippingFaceCapCm = 1.0;
 /// The pipeline runs its shape steps again, with the curves lifted where the

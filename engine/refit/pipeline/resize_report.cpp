@@ -109,6 +109,7 @@ nlohmann::json features_report(const FeatureResult& curves) {
                     {"crossings", crossings},
                     {"cleared", cleared},
                     {"followed", followed},
+                    {"placed", c.placed},
                     {"level", c.level},
                     {"scale_warped", c.scale_warped},
                     {"scale_result", c.scale_result},
