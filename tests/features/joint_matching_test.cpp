@@ -57,6 +57,24 @@ FeatureResult solve(const std::vector<FeatureCurve>& curves, const std::function
 Vec3 sink(const Vec3& p) { return bend(p) - Vec3(0, 2.5 * std::exp(-p.x() * p.x() / 8.0), 0); }
 ClearanceNeed floor_need(const Vec3& p, double clearance) { return ClearanceNeed{Vec3::UnitY(), clearance - p.y()}; }
 
+// One curve (samples s, in z = 0) over body B's floor y = floor_y(x), where the
+// warp keeps each sample's height over the floor; solved with options o.
+CurveResult solve_over_floor(const Points& s, const std::function<double(double)>& floor_y, const ShapeMatchingOptions& o) {
+  const std::vector<FeatureCurve> curves = {
+      make_feature_curve("A", s, false, FeaturePlane::from_point_normal(Vec3::Zero(), Vec3::UnitZ()), {}, 0)};
+  const auto warp = [&](const Vec3& p) { return Vec3(p.x(), p.y() + floor_y(p.x()), p.z()); };
+  const auto distance = [&](const Vec3& p) { return p.y() - floor_y(p.x()); };
+  const ClearanceToBody floor = [&](const Vec3& p, double clearance) {
+    return ClearanceNeed{Vec3::UnitY(), clearance - distance(p)};
+  };
+  std::vector<Points> ws, wa;
+  for (const FeatureCurve& c : curves) {
+    ws.push_back(map_rows(c.samples, warp));
+    wa.push_back(map_rows(c.aux, warp));
+  }
+  return match_shapes(prepare_shape_model(curves, o), ws, wa, distance, floor).curves[0];
+}
+
 }  // namespace
 
 TEST(JointMatching, CrossingCurvesShareTheirMeetingSampleAndKeepTheirShapes) {
@@ -292,24 +310,13 @@ TEST(JointMatching, SamplesThatSatOnBodyAFollowBodyB) {
     const double x = -10.0 + 0.5 * i;
     s.row(i) << x, 0.5 + (x > 0.0 ? 0.4 * x : 0.0), 0.0;
   }
-  const std::vector<FeatureCurve> curves = {
-      make_feature_curve("A", s, false, FeaturePlane::from_point_normal(Vec3::Zero(), Vec3::UnitZ()), {}, 0)};
-  const auto warp = [&](const Vec3& p) { return Vec3(p.x(), p.y() + dip(p.x()), p.z()); };
   const auto distance = [&](const Vec3& p) { return p.y() - dip(p.x()); };
-  const ClearanceToBody floor = [&](const Vec3& p, double clearance) {
-    return ClearanceNeed{Vec3::UnitY(), clearance - distance(p)};
-  };
   const auto run = [&](double follow) {
     ShapeMatchingOptions o;
     o.clearance = 0.1;
     o.follow_body = follow;
     o.follow_tolerance = 0.1;
-    std::vector<Points> ws, wa;
-    for (const FeatureCurve& c : curves) {
-      ws.push_back(map_rows(c.samples, warp));
-      wa.push_back(map_rows(c.aux, warp));
-    }
-    return match_shapes(prepare_shape_model(curves, o), ws, wa, distance, floor).curves[0];
+    return solve_over_floor(s, dip, o);
   };
   const CurveResult free_curve = run(0.0), followed = run(1.0);
   double free_off = 0.0, off = 0.0;
@@ -338,24 +345,11 @@ namespace {
 CurveResult straightened_over_a_bowl(double height, double band) {
   Points s(41, 3);
   for (int i = 0; i < 41; ++i) s.row(i) << -10.0 + 0.5 * i, height, 0.0;
-  const std::vector<FeatureCurve> curves = {
-      make_feature_curve("A", s, false, FeaturePlane::from_point_normal(Vec3::Zero(), Vec3::UnitZ()), {}, 0)};
-  const auto floor_y = [](double x) { return 0.05 * x * x; };
-  const auto warp = [&](const Vec3& p) { return Vec3(p.x(), p.y() + floor_y(p.x()), p.z()); };
-  const auto distance = [&](const Vec3& p) { return p.y() - floor_y(p.x()); };
-  const ClearanceToBody floor = [&](const Vec3& p, double clearance) {
-    return ClearanceNeed{Vec3::UnitY(), clearance - distance(p)};
-  };
   ShapeMatchingOptions o;
   o.clearance = 0.25;
   o.placement_band = band;
   o.placement_near = 1.0;
-  std::vector<Points> ws, wa;
-  for (const FeatureCurve& c : curves) {
-    ws.push_back(map_rows(c.samples, warp));
-    wa.push_back(map_rows(c.aux, warp));
-  }
-  return match_shapes(prepare_shape_model(curves, o), ws, wa, distance, floor).curves[0];
+  return solve_over_floor(s, [](double x) { return 0.05 * x * x; }, o);
 }
 
 double lowest_over_floor(const CurveResult& c) {
