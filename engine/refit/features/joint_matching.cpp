@@ -119,6 +119,8 @@ CurveFrame curve_frame(const FeatureCurve& c, const Points& ws, const Points& wa
 struct Expr {
   std::vector<std::pair<std::size_t, double>> terms;
   Vec3 constant = Vec3::Zero();
+  // One slot itself: a curve's own sample (a crossing is another curve's point).
+  bool is_slot() const { return terms.size() == 1 && terms[0].second == 1.0 && constant.isZero(); }
 };
 
 // The least-squares problem: rows over samples (through their Expr) and plane
@@ -233,8 +235,7 @@ std::vector<Vec3> spread_moves(const ShapeModel& model, const std::vector<std::v
     // The curve's own samples (not crossings) and their arc length on the original.
     std::vector<std::size_t> own(m, slots);
     for (std::size_t i = 0; i < m; ++i)
-      if (expr[k][i].terms.size() == 1 && expr[k][i].terms[0].second == 1.0 && expr[k][i].constant.isZero())
-        own[i] = expr[k][i].terms[0].first;
+      if (expr[k][i].is_slot()) own[i] = expr[k][i].terms[0].first;
     std::vector<double> arc(m, 0.0);
     for (std::size_t i = 1; i < m; ++i) arc[i] = arc[i - 1] + (row3(c.samples, Index(i)) - row3(c.samples, Index(i - 1))).norm();
     const double total = polyline_length(c.samples, c.closed);
@@ -273,7 +274,7 @@ std::vector<Vec3> spread_moves(const ShapeModel& model, const std::vector<std::v
 
 // The placement step of match_shapes_jointly (see there): a curve's own samples
 // (`slots`, in its plane) turned and scaled about `pivot`, and moved in the plane
-// as well when `free`, by least squares on what each still needs to clear body B
+// as well when `in_plane`, by least squares on what each still needs to clear body B
 // (a little regularisation keeps the move small); over rounds, as samples come
 // to need it. Samples needing more than `threshold` are cleared; those the warp
 // left within `near` of body B are held to `band` farther off than the warp put
@@ -281,13 +282,13 @@ std::vector<Vec3> spread_moves(const ShapeModel& model, const std::vector<std::v
 // ShapeMatchingOptions::placement_band) and the curve is as it was.
 template <class Need>
 double place_clear(const std::vector<std::size_t>& slots, const std::vector<double>& warped_distance,
-                   const std::vector<double>& clearance, const FeaturePlane& plane, const Vec3& pivot, bool free,
+                   const std::vector<double>& clearance, const FeaturePlane& plane, const Vec3& pivot, bool in_plane,
                    double near, double band, double threshold, JointSystem& sys, const Need& need_of) {
   constexpr double kRegularisation = 0.01;
   constexpr int kRounds = 8;
   const std::size_t n = slots.size();
   const Vec3 normal = plane.normal.normalized();
-  const int unknowns = free ? 4 : 2;
+  const int unknowns = in_plane ? 4 : 2;
   std::vector<Vec3> start(n);
   for (std::size_t j = 0; j < n; ++j) start[j] = sys.slot(slots[j]);
   // The move's columns at p: a turn about the plane's normal, a scale, in-plane moves.
@@ -581,22 +582,21 @@ FeatureResult match_shapes_jointly(const ShapeModel& model, const std::vector<Po
       std::vector<std::size_t> slots;
       std::vector<double> near_distance, clearance;
       for (std::size_t i = 0; i < m; ++i)
-        if (!crossing[k][i] && expr[k][i].terms.size() == 1 && expr[k][i].terms[0].second == 1.0 &&
-            expr[k][i].constant.isZero()) {
+        if (!crossing[k][i] && expr[k][i].is_slot()) {
           slots.push_back(expr[k][i].terms[0].first);
           near_distance.push_back(warped_distance[k][i]);
           clearance.push_back(clearance_of(k, i));
         }
       if (slots.size() < 3) continue;
-      const bool free = model.crossings[k].empty();
+      const bool unpinned = model.crossings[k].empty();
       Vec3 pivot = Vec3::Zero();
-      if (free) {
+      if (unpinned) {
         for (const std::size_t s : slots) pivot += sys.slot(s);
         pivot /= double(slots.size());
       } else {
         pivot = sys.eval(expr[k][model.crossings[k][0].sample]);
       }
-      placed[k] = place_clear(slots, near_distance, clearance, frame[k].plane, pivot, free, o.placement_near,
+      placed[k] = place_clear(slots, near_distance, clearance, frame[k].plane, pivot, unpinned, o.placement_near,
                               o.placement_band, 1e-3 * o.clearance, sys,
                               [&](std::size_t j, const Vec3& p) { return clearance_to_body_b(p, clearance[j]); });
     }
@@ -621,8 +621,7 @@ FeatureResult match_shapes_jointly(const ShapeModel& model, const std::vector<Po
     const auto moved_samples = [&](const std::vector<Vec3>& per_slot, const char* reason) {
       std::vector<FixedSample> out;
       for (std::size_t i = 0; i < m && !per_slot.empty(); ++i)
-        if (expr[k][i].terms.size() == 1 && expr[k][i].terms[0].second == 1.0 && !crossing[k][i] &&
-            per_slot[expr[k][i].terms[0].first].squaredNorm() > 0.0)
+        if (!crossing[k][i] && expr[k][i].is_slot() && per_slot[expr[k][i].terms[0].first].squaredNorm() > 0.0)
           out.push_back({Index(i), reason, per_slot[expr[k][i].terms[0].first].norm()});
       return out;
     };
