@@ -220,8 +220,9 @@ def boundary_curve(positions, faces, ids, near):
     return Carried(best, best, np.zeros(len(best)))
 
 
-def similarity_rms(x, y):
-    """RMS distance between x and y (n, 3) after the best similarity alignment of x onto y (Umeyama)."""
+def umeyama(x, y):
+    """The similarity taking x onto y (n, 3) in the least squares sense (Umeyama): rotation r,
+    scale s and the centroids mx, my (x maps to s (x - mx) r^T + my)."""
     mx, my = x.mean(0), y.mean(0)
     xc, yc = x - mx, y - my
     cov = yc.T @ xc / len(x)
@@ -231,8 +232,13 @@ def similarity_rms(x, y):
         d[-1] = -1
     r = u @ np.diag(d) @ vt
     var = (xc ** 2).sum() / len(x)
-    scale = (sv * d).sum() / max(var, 1e-30)
-    aligned = scale * xc @ r.T + my
+    return r, (sv * d).sum() / max(var, 1e-30), mx, my
+
+
+def similarity_rms(x, y):
+    """RMS distance between x and y (n, 3) after the best similarity alignment of x onto y (Umeyama)."""
+    r, scale, mx, my = umeyama(x, y)
+    aligned = scale * (x - mx) @ r.T + my
     return float(np.sqrt(((aligned - y) ** 2).sum(1).mean()))
 
 

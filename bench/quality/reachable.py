@@ -35,19 +35,6 @@ import run  # noqa: E402
 NEAR_CM = 1.0  # as the suite's near-body change
 
 
-def umeyama(x, y):
-    """The similarity (r, s, t) taking x onto y in the least squares sense."""
-    mx, my = x.mean(0), y.mean(0)
-    xc, yc = x - mx, y - my
-    u, sv, vt = np.linalg.svd(yc.T @ xc / len(x))
-    d = np.ones(3)
-    if np.linalg.det(u) * np.linalg.det(vt) < 0:
-        d[-1] = -1
-    r = u @ np.diag(d) @ vt
-    s = (sv * d).sum() / ((xc ** 2).sum() / len(x))
-    return r, s, my - s * r @ mx
-
-
 def least_error(x, warped, starts, body_b, near, lo, hi, clearance, reach):
     """Least shape error of the original samples x placed by a similarity under the constraints
     (and the placement's parameters: rotation vector, translation, log scale)."""
@@ -65,7 +52,8 @@ def least_error(x, warped, starts, body_b, near, lo, hi, clearance, reach):
 
     best = None
     for y in starts:
-        r, s, t = umeyama(x, y)
+        r, s, mx, my = meshes.umeyama(x, y)
+        t = my - s * r @ mx
         p0 = np.concatenate([Rotation.from_matrix(r).as_rotvec(), t, [np.log(s)]])
         res = minimize(lambda p: float((violation(p) ** 2).sum()), p0, method="Powell",
                        options={"xtol": 1e-7, "ftol": 1e-14, "maxfev": 40000})
