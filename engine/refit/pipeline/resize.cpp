@@ -385,6 +385,51 @@ void GarmentBinding::symmetrise_garment(Points& positions) const {
     if (garment_paired_[i]) positions.row(i) = 0.5 * (positions.row(i) + mirrored.row(i));
 }
 
+Vec3 GarmentBinding::mirrored_move(const Points& before, const Points& after, Index i) const {
+  Vec3 m = carry_one(garment_mirror_, after, i) - carry_one(garment_mirror_, before, i);  // the offsets cancel
+  m.x() = -m.x();
+  return m;
+}
+
+// Elsewhere both moves are zero exactly (the same arithmetic on the same rows),
+// so a rule that leaves a vertex with no move and no image's move alone may skip
+// it. Rows are gathered per block, in vertex order.
+template <class Row>
+std::vector<std::pair<Index, Vec3>> GarmentBinding::paired_moving_rows(const Points& before, const Points& after,
+                                                                      const Row& row) const {
+  const std::size_t n = std::size_t(after.rows());
+  std::vector<std::uint8_t> moved(n);
+  parallel_for(0, n, 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t v = b; v < e; ++v) moved[v] = after.row(Eigen::Index(v)) != before.row(Eigen::Index(v));
+  });
+  constexpr std::size_t kBlock = 4096;
+  std::vector<std::vector<std::pair<Index, Vec3>>> rows((n + kBlock - 1) / kBlock);
+  parallel_for(0, rows.size(), 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k)
+      for (std::size_t v = k * kBlock; v < std::min(n, (k + 1) * kBlock); ++v) {
+        const auto& image = garment_mirror_.vertex[v];
+        if (!garment_paired_[v] || !(moved[v] || moved[image[0]] || moved[image[1]] || moved[image[2]])) continue;
+        if (const std::optional<Vec3> p = row(Index(v))) rows[k].emplace_back(Index(v), *p);
+      }
+  });
+  std::vector<std::pair<Index, Vec3>> out;
+  for (const auto& r : rows) out.insert(out.end(), r.begin(), r.end());
+  return out;
+}
+
+// The snap moves a few thousand vertices of a million: only those and the
+// vertices whose mirror image lies on a face they are corners of are looked at
+// (a row whose own and mirrored moves are both zero stays, as in
+// symmetrised_move_rows).
+void GarmentBinding::symmetrise_moves(const Points& before, Points& positions) const {
+  const auto rows = paired_moving_rows(before, positions, [&](Index i) -> std::optional<Vec3> {
+    const Vec3 own = row3(positions, i) - row3(before, i), other = mirrored_move(before, positions, i);
+    if (own == Vec3::Zero() && other == Vec3::Zero()) return std::nullopt;
+    return Vec3(row3(before, i) + 0.5 * (own + other));
+  });
+  for (const auto& [i, p] : rows) positions.row(i) = p.transpose();
+}
+
 // The collision step pushes each side by what it needs, and neither body B's
 // triangulation nor the garment's mesh is mirror-symmetric, so the two sides of
 // a symmetric pair come out pushed differently (the real dress on a shorter
@@ -396,65 +441,17 @@ void GarmentBinding::symmetrise_garment(Points& positions) const {
 // near vertices / over those whose faces the input keeps clear of body A), from
 // 0.58 / 0.34 cm without this: the larger push for both sides 0.69 cm over all;
 // the plain mean 0.56 / 0.38; the capped mean (this) 0.56 / 0.34.
-Points GarmentBinding::mirrored_moves(const Points& before, const Points& after) const {
-  Points mirrored = carry(garment_mirror_, after) - carry(garment_mirror_, before);  // the offsets cancel
-  mirrored.col(0) = -mirrored.col(0);
-  return mirrored;
-}
-
-// The snap moves a few thousand vertices of a million: only those and the
-// vertices whose mirror image lies on a face they are corners of are looked at
-// (a row whose own and mirrored moves are both zero stays, as in
-// symmetrised_move_rows). New rows are gathered per block, then written.
-void GarmentBinding::symmetrise_moves(const Points& before, Points& positions) const {
-  const std::size_t n = std::size_t(positions.rows());
-  std::vector<std::uint8_t> moved(n);
-  parallel_for(0, n, 4096, [&](std::size_t b, std::size_t e) {
-    for (std::size_t v = b; v < e; ++v) moved[v] = positions.row(Eigen::Index(v)) != before.row(Eigen::Index(v));
-  });
-  constexpr std::size_t kBlock = 4096;
-  std::vector<std::vector<std::pair<Index, Vec3>>> rows((n + kBlock - 1) / kBlock);
-  const auto block = [&](std::size_t k) {
-    for (std::size_t v = k * kBlock; v < std::min(n, (k + 1) * kBlock); ++v) {
-      const auto& image = garment_mirror_.vertex[v];
-      if (!garment_paired_[v] || !(moved[v] || moved[image[0]] || moved[image[1]] || moved[image[2]])) continue;
-      const Index i = Index(v);
-      Vec3 other = carry_one(garment_mirror_, positions, i) - carry_one(garment_mirror_, before, i);  // mirrored_moves' row
-      other.x() = -other.x();
-      const Vec3 own = row3(positions, i) - row3(before, i);
-      if (own == Vec3::Zero() && other == Vec3::Zero()) continue;
-      rows[k].emplace_back(i, row3(before, i) + 0.5 * (own + other));
-    }
-  };
-  parallel_for(0, rows.size(), 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t k = b; k < e; ++k) block(k);
-  });
-  for (const auto& r : rows)
-    for (const auto& [i, p] : r) positions.row(i) = p.transpose();
-}
-
 std::vector<std::pair<Index, Vec3>> GarmentBinding::symmetric_pushes(const Points& before, const Points& after,
                                                                     double tolerance, double max_extra) const {
-  Points mirrored = mirrored_moves(before, after);
-  const std::size_t n = std::size_t(after.rows());
-  std::vector<std::uint8_t> moved(n, 0);
-  parallel_for(0, n, 4096, [&](std::size_t b, std::size_t e) {
-    for (std::size_t v = b; v < e; ++v) {
-      const Index i = Index(v);
-      const Vec3 push = row3(after, i) - row3(before, i), other = row3(mirrored, i);
-      if (!garment_paired_[v] || !((other - push).norm() > tolerance)) continue;
-      Vec3 to = 0.5 * (push + other);
-      const Vec3 extra = to - push;
-      if (to.squaredNorm() > push.squaredNorm() && extra.norm() > max_extra)
-        to = push + (max_extra / extra.norm()) * extra;  // the side that needed less
-      mirrored.row(i) = (row3(before, i) + to).transpose();  // mirrored now holds the new position
-      moved[v] = 1;
-    }
+  return paired_moving_rows(before, after, [&](Index i) -> std::optional<Vec3> {
+    const Vec3 push = row3(after, i) - row3(before, i), other = mirrored_move(before, after, i);
+    if (!((other - push).norm() > tolerance)) return std::nullopt;
+    Vec3 to = 0.5 * (push + other);
+    const Vec3 extra = to - push;
+    if (to.squaredNorm() > push.squaredNorm() && extra.norm() > max_extra)
+      to = push + (max_extra / extra.norm()) * extra;  // the side that needed less
+    return Vec3(row3(before, i) + to);
   });
-  std::vector<std::pair<Index, Vec3>> moves;
-  for (std::size_t v = 0; v < n; ++v)
-    if (moved[v]) moves.emplace_back(Index(v), row3(mirrored, Index(v)));
-  return moves;
 }
 
 void GarmentBinding::feature_step(const TriangleFrames& frames_b, const BodySurface& surface_b, bool symmetric_b,

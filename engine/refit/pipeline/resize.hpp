@@ -122,9 +122,14 @@ class GarmentBinding {
                                                       double max_extra) const;
   void metrics_step(const BodySurface& surface_b, ResizeResult& result, const Progress& progress) const;
   void symmetrise_garment(Points& positions) const;
-  /// Per vertex: the move of its mirror image (carried on the garment's faces) from `before` to `after`, mirrored
+  /// Vertex i's mirror image's move (carried on the garment's faces) from `before` to `after`, mirrored
   /// about the plane; meaningful where the vertex is paired.
-  Points mirrored_moves(const Points& before, const Points& after) const;
+  Vec3 mirrored_move(const Points& before, const Points& after, Index i) const;
+  /// The paired vertices whose own move from `before` to `after` or whose image's may
+  /// not be zero (it or a corner of its image's face moved), with `row(i)` of each,
+  /// in vertex order: a collision step or a snap moves a few of a million vertices.
+  template <class Row>
+  std::vector<std::pair<Index, Vec3>> paired_moving_rows(const Points& before, const Points& after, const Row& row) const;
   /// Each paired vertex's move from `before` to `positions` becomes the mean of its own and its image's, mirrored.
   void symmetrise_moves(const Points& before, Points& positions) const;
   const Csr& vertex_adjacency_once() const;
