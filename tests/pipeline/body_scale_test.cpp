@@ -3,7 +3,7 @@
 // kept as SurfaceOptions::follow_body_scale = false, keeps more of its length),
 // and the stretch each piece follows is the one of the warp.
 #include "support/shapes.hpp"
-#include "support/test_support.hpp"
+#include "shared_case.hpp"
 
 #include <mannequin/mannequin.hpp>
 #include <refit/features/feature_file.hpp>
@@ -68,10 +68,10 @@ TEST(BodyScale, DressOnAShorterBodyIsShorterByAsMuchAsTheWarpSays) {
 // absolute encoding kept 1.8 % more than the warp's height (measured), the
 // stretch follows it.
 TEST(BodyScale, SharedSuitOnAShorterBody) {
-  const std::string data = test::shared_data_dir();
-  if (data.empty()) GTEST_SKIP() << "../shared/data is absent: real-data body-scale test skipped";
-  auto suit = std::make_shared<const Garment>(read_garment_obj(data + "/garments/male_suit_on_M_ref.obj"));
-  const BodyMesh a = read_body(data + "/bodies/M_ref.obj");
+  const auto shared = test::shared_case("male_suit");
+  if (!shared) GTEST_SKIP() << "../shared/data is absent: real-data body-scale test skipped";
+  const auto& suit = shared->garment;
+  const BodyMesh& a = shared->body_a;
   BodyMesh b = a;
   const double floor = a.vertices.col(1).minCoeff();
   b.vertices.col(1) = (a.vertices.col(1).array() - floor) * 0.91 + floor;

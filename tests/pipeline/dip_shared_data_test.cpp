@@ -4,7 +4,7 @@
 // B, and the written garment left the curve there by 0.18-0.27 cm. The curves
 // now keep their clearance plus that dip (dipping_face_clearance in
 // pipeline/resize.cpp). Skips when ../shared/data is absent.
-#include "support/test_support.hpp"
+#include "shared_case.hpp"
 
 #include <refit/features/feature_file.hpp>
 #include <refit/io/body_io.hpp>
@@ -19,15 +19,12 @@ namespace refit {
 namespace {
 
 TEST(DipSharedData, TheWrittenSkirtPassesThroughItsCurves) {
-  const std::string data = test::shared_data_dir();
-  if (data.empty()) GTEST_SKIP() << "../shared/data is absent: real-data skirt gap test skipped";
-  auto garment = std::make_shared<const Garment>(read_garment_obj(data + "/garments/skirt_on_A_female.obj"));
-  const std::vector<FeatureSpec> features =
-      read_feature_file(std::string(REFIT_SOURCE_DIR) + "/bench/quality/features/skirt.json");
-  const GarmentBinding binding(garment, read_body(data + "/bodies/A_female.obj"), {}, features);
+  const auto skirt = test::shared_case("skirt");
+  if (!skirt) GTEST_SKIP() << "../shared/data is absent: real-data skirt gap test skipped";
+  const GarmentBinding binding(skirt->garment, skirt->body_a, {}, skirt->features);
   for (const char* target : {"F_heavier", "F_thinner", "F_taller"}) {
     SCOPED_TRACE(target);
-    const ResizeResult r = binding.resize(read_body(data + "/bodies/" + target + ".obj"));
+    const ResizeResult r = binding.resize(skirt->body(target));
     const double written = r.report.at("surface").at("feature_gap_written");
     std::printf("[ info ] skirt -> %s: written feature gap %.3f cm\n", target, written);
     EXPECT_LE(written, 0.05);

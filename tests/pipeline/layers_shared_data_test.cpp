@@ -4,7 +4,7 @@
 // so they were attached to the jeans, which the collision step then moved
 // (written feature gap 0.22 cm on F_heavier, 0.21 on F_taller).
 // Skips when ../shared/data is absent.
-#include "support/test_support.hpp"
+#include "shared_case.hpp"
 
 #include <refit/io/body_io.hpp>
 #include <refit/io/obj_garment.hpp>
@@ -18,14 +18,11 @@ namespace refit {
 namespace {
 
 TEST(LayersSharedData, OutfitProfilesStayOnTheDress) {
-  const std::string data = test::shared_data_dir();
-  if (data.empty()) GTEST_SKIP() << "../shared/data is absent: real-data layer test skipped";
-  auto garment = std::make_shared<const Garment>(read_garment_obj(data + "/garments/outfit_dress_jeans_on_A_female.obj"));
-  const GarmentBinding binding(
-      garment, read_body(data + "/bodies/A_female.obj"), {},
-      read_feature_file(std::string(REFIT_SOURCE_DIR) + "/bench/quality/features/outfit_dress_jeans.json"));
+  const auto outfit = test::shared_case("outfit_dress_jeans");
+  if (!outfit) GTEST_SKIP() << "../shared/data is absent: real-data layer test skipped";
+  const GarmentBinding binding(outfit->garment, outfit->body_a, {}, outfit->features);
   for (const char* target : {"F_heavier", "F_taller"}) {
-    const ResizeResult r = binding.resize(read_body(data + "/bodies/" + target + ".obj"));
+    const ResizeResult r = binding.resize(outfit->body(target));
     const double gap = r.report.at("surface").at("feature_gap_written").get<double>();
     std::printf("[ info ] outfit -> %s: written feature gap %.3f cm\n", target, gap);
     EXPECT_LE(gap, 0.05) << target;

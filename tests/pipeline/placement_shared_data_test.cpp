@@ -7,7 +7,7 @@
 // each given profile comes out at least 10x closer (the quality suite's own
 // measure: 11x), the mirrored one 8.5x (the suite holds it to 3x, as a profile
 // between the features). Skips when ../shared/data is absent.
-#include "support/test_support.hpp"
+#include "shared_case.hpp"
 
 #include <refit/features/feature_file.hpp>
 #include <refit/io/body_io.hpp>
@@ -22,12 +22,11 @@ namespace refit {
 namespace {
 
 TEST(PlacementSharedData, TheSkirtOnAShorterBodyKeepsItsProfilesShape) {
-  const std::string data = test::shared_data_dir();
-  if (data.empty()) GTEST_SKIP() << "../shared/data is absent: real-data placement test skipped";
-  auto skirt = std::make_shared<const Garment>(read_garment_obj(data + "/garments/skirt_on_A_female.obj"));
-  const std::vector<FeatureSpec> features =
-      read_feature_file(std::string(REFIT_SOURCE_DIR) + "/bench/quality/features/skirt.json");
-  const BodyMesh a = read_body(data + "/bodies/A_female.obj");
+  const auto shared = test::shared_case("skirt");
+  if (!shared) GTEST_SKIP() << "../shared/data is absent: real-data placement test skipped";
+  const auto& skirt = shared->garment;
+  const BodyMesh& a = shared->body_a;
+  const std::vector<FeatureSpec>& features = shared->features;
   BodyMesh b = a;  // 9 % shorter, as wide (its heights scaled about the soles)
   const double floor = a.vertices.col(1).minCoeff();
   b.vertices.col(1) = (a.vertices.col(1).array() - floor) * 0.91 + floor;

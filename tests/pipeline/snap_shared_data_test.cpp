@@ -12,7 +12,7 @@
 // profile, 0.072 once written on F_thinner. The snap runs again after it, its
 // moves made alike on both sides (GarmentBinding::surface_step). Skips when
 // ../shared/data is absent.
-#include "support/test_support.hpp"
+#include "shared_case.hpp"
 
 #include <refit/features/feature_file.hpp>
 #include <refit/io/body_io.hpp>
@@ -30,12 +30,11 @@ namespace refit {
 namespace {
 
 TEST(SnapSharedData, TheWrittenDressPassesThroughItsSideProfiles) {
-  const std::string data = test::shared_data_dir();
-  if (data.empty()) GTEST_SKIP() << "../shared/data is absent: real-data dress gap test skipped";
-  auto garment = std::make_shared<const Garment>(read_garment_obj(data + "/garments/dress_on_A_female.obj"));
-  const std::vector<FeatureSpec> features =
-      read_feature_file(std::string(REFIT_SOURCE_DIR) + "/bench/quality/features/dress.json");
-  const BodyMesh a = read_body(data + "/bodies/A_female.obj");
+  const auto dress = test::shared_case("dress");
+  if (!dress) GTEST_SKIP() << "../shared/data is absent: real-data dress gap test skipped";
+  const auto& garment = dress->garment;
+  const BodyMesh& a = dress->body_a;
+  const std::vector<FeatureSpec>& features = dress->features;
   const GarmentBinding binding(garment, a, {}, features);
   ResizeOptions through_blends;
   through_blends.surface.snap_radius = 0.0;
@@ -43,7 +42,7 @@ TEST(SnapSharedData, TheWrittenDressPassesThroughItsSideProfiles) {
   const GarmentBinding before(garment, a, through_blends, features);
   for (const char* target : {"F_thinner", "F_heavier"}) {
     SCOPED_TRACE(target);
-    const BodyMesh b = read_body(data + "/bodies/" + target + ".obj");
+    const BodyMesh b = dress->body(target);
     const ResizeResult r = binding.resize(b);
     const double gap = r.report.at("surface").at("feature_gap").get<double>();
     const double written = r.report.at("surface").at("feature_gap_written").get<double>();
@@ -56,13 +55,10 @@ TEST(SnapSharedData, TheWrittenDressPassesThroughItsSideProfiles) {
 }
 
 TEST(SnapSharedData, TheWrittenOutfitPassesThroughItsMirroredSideProfile) {
-  const std::string data = test::shared_data_dir();
-  if (data.empty()) GTEST_SKIP() << "../shared/data is absent: real-data outfit gap test skipped";
-  auto garment = std::make_shared<const Garment>(read_garment_obj(data + "/garments/outfit_dress_jeans_on_A_female.obj"));
-  const std::vector<FeatureSpec> features =
-      read_feature_file(std::string(REFIT_SOURCE_DIR) + "/bench/quality/features/outfit_dress_jeans.json");
-  const GarmentBinding binding(garment, read_body(data + "/bodies/A_female.obj"), {}, features);
-  const ResizeResult r = binding.resize(read_body(data + "/bodies/F_thinner.obj"));
+  const auto outfit = test::shared_case("outfit_dress_jeans");
+  if (!outfit) GTEST_SKIP() << "../shared/data is absent: real-data outfit gap test skipped";
+  const GarmentBinding binding(outfit->garment, outfit->body_a, {}, outfit->features);
+  const ResizeResult r = binding.resize(outfit->body("F_thinner"));
   const nlohmann::json& s = r.report.at("surface");
   const double symmetrised = s.at("feature_gap_symmetrised").get<double>();
   const double written = s.at("feature_gap_written").get<double>();
@@ -78,21 +74,21 @@ TEST(SnapSharedData, TheWrittenOutfitPassesThroughItsMirroredSideProfile) {
 // own moves are not: the two sides' quads are cut into triangles differently,
 // and it left the waist 0.05 cm out of symmetry before its moves were made alike.
 TEST(SnapSharedData, TheSnapAfterTheSymmetrisationKeepsTheSkirtSymmetric) {
-  const std::string data = test::shared_data_dir();
-  if (data.empty()) GTEST_SKIP() << "../shared/data is absent: real-data skirt symmetry test skipped";
-  auto garment = std::make_shared<const Garment>(read_garment_obj(data + "/garments/skirt_on_A_female.obj"));
-  const std::vector<FeatureSpec> features =
-      read_feature_file(std::string(REFIT_SOURCE_DIR) + "/bench/quality/features/skirt.json");
+  const auto skirt = test::shared_case("skirt");
+  if (!skirt) GTEST_SKIP() << "../shared/data is absent: real-data skirt symmetry test skipped";
+  const auto& garment = skirt->garment;
+  const BodyMesh& a = skirt->body_a;
+  const std::vector<FeatureSpec>& features = skirt->features;
   ResizeOptions o;
   o.collision = false;
-  const GarmentBinding binding(garment, read_body(data + "/bodies/A_female.obj"), o, features);
+  const GarmentBinding binding(garment, a, o, features);
   const Points& x = garment->positions;
   std::map<std::tuple<double, double, double>, Index> at;
   for (Index i = 0; i < x.rows(); ++i) at[{x(i, 0), x(i, 1), x(i, 2)}] = i;
   // (On F_heavier that snap is not kept: it takes one side profile 0.003 cm farther off.)
   for (const char* target : {"F_thinner", "F_taller"}) {
     SCOPED_TRACE(target);
-    const ResizeResult r = binding.resize(read_body(data + "/bodies/" + target + ".obj"));
+    const ResizeResult r = binding.resize(skirt->body(target));
     ASSERT_TRUE(r.report.at("surface").at("snapped_after_symmetrising").get<bool>());
     double worst = 0.0;
     std::size_t pairs = 0;
@@ -118,13 +114,12 @@ TEST(SnapSharedData, TheSnapAfterTheSymmetrisationKeepsTheSkirtSymmetric) {
 // steps then run again with those samples kept as far off as the push left
 // them (ResizeOptions::lift_pushed_curves).
 TEST(SnapSharedData, TheCurvesLiftWhereTheCollisionStepPushedTheirFaces) {
-  const std::string data = test::shared_data_dir();
-  if (data.empty()) GTEST_SKIP() << "../shared/data is absent: real-data lifted curves test skipped";
-  auto garment = std::make_shared<const Garment>(read_garment_obj(data + "/garments/dress_on_A_female.obj"));
-  const std::vector<FeatureSpec> features =
-      read_feature_file(std::string(REFIT_SOURCE_DIR) + "/bench/quality/features/dress.json");
-  const BodyMesh a = read_body(data + "/bodies/A_female.obj");
-  BodyMesh heaviest = read_body(data + "/bodies/F_heavier.obj");
+  const auto dress = test::shared_case("dress");
+  if (!dress) GTEST_SKIP() << "../shared/data is absent: real-data lifted curves test skipped";
+  const auto& garment = dress->garment;
+  const BodyMesh& a = dress->body_a;
+  const std::vector<FeatureSpec>& features = dress->features;
+  BodyMesh heaviest = dress->body("F_heavier");
   heaviest.vertices = a.vertices + 1.6 * (heaviest.vertices - a.vertices);
   ResizeOptions unlifted;
   unlifted.lift_pushed_curves = false;

@@ -5,7 +5,7 @@
 // (here: at least twice as symmetric);
 // a lopsided body B is not forced into symmetry.
 // Skips when ../shared/data is absent.
-#include "support/test_support.hpp"
+#include "shared_case.hpp"
 
 #include <refit/body/centre_tree.hpp>
 #include <refit/io/body_io.hpp>
@@ -36,14 +36,14 @@ double mirror_error(const Points& original, const Points& p) {
 }
 
 TEST(SymmetrySharedData, OneSidedProfileKeepsSkirtSymmetric) {
-  const std::string data = test::shared_data_dir();
-  if (data.empty()) GTEST_SKIP() << "../shared/data is absent: real-data symmetry test skipped";
-  auto garment = std::make_shared<const Garment>(read_garment_obj(data + "/garments/skirt_on_A_female.obj"));
-  const BodyMesh a = read_body(data + "/bodies/A_female.obj");
-  const GarmentBinding binding(garment, a, {},
-                               read_feature_file(std::string(REFIT_SOURCE_DIR) + "/bench/quality/features/skirt.json"));
+  const auto skirt = test::shared_case("skirt");
+  if (!skirt) GTEST_SKIP() << "../shared/data is absent: real-data symmetry test skipped";
+  const auto& garment = skirt->garment;
+  const BodyMesh& a = skirt->body_a;
+  const std::vector<FeatureSpec>& features = skirt->features;
+  const GarmentBinding binding(garment, a, {}, features);
   for (const char* target : {"F_heavier", "F_thinner"}) {
-    const ResizeResult r = binding.resize(read_body(data + "/bodies/" + target + ".obj"));
+    const ResizeResult r = binding.resize(skirt->body(target));
     const nlohmann::json& sym = r.report.at("symmetry");
     EXPECT_TRUE(sym.at("symmetric").get<bool>()) << target;
     EXPECT_EQ(sym.at("mirrored_features"), nlohmann::json::array({"left~mirror"})) << target;
@@ -63,7 +63,7 @@ TEST(SymmetrySharedData, OneSidedProfileKeepsSkirtSymmetric) {
     EXPECT_TRUE(sym.at("symmetrised").get<bool>()) << target;
   }
   // A body B that is not symmetric (its left side 5 % wider) is not forced into symmetry.
-  BodyMesh lopsided = read_body(data + "/bodies/F_heavier.obj");
+  BodyMesh lopsided = skirt->body("F_heavier");
   for (Eigen::Index i = 0; i < lopsided.vertices.rows(); ++i)
     if (lopsided.vertices(i, 0) > 0.0) lopsided.vertices(i, 0) *= 1.05;
   const ResizeResult r = binding.resize(lopsided);
@@ -76,11 +76,11 @@ TEST(SymmetrySharedData, OneSidedProfileKeepsSkirtSymmetric) {
 // It is detected symmetric, and the written suit is at most 0.1 cm less
 // symmetric than the warp (before: 0.68 cm against the warp's 0.49 on M_heavier).
 TEST(SymmetrySharedData, SuitWithOverlappingFrontStaysSymmetric) {
-  const std::string data = test::shared_data_dir();
-  if (data.empty()) GTEST_SKIP() << "../shared/data is absent: real-data symmetry test skipped";
-  auto garment = std::make_shared<const Garment>(read_garment_obj(data + "/garments/male_suit_on_M_ref.obj"));
-  const GarmentBinding binding(garment, read_body(data + "/bodies/M_ref.obj"));
-  const ResizeResult r = binding.resize(read_body(data + "/bodies/M_heavier.obj"));
+  const auto suit = test::shared_case("male_suit");
+  if (!suit) GTEST_SKIP() << "../shared/data is absent: real-data symmetry test skipped";
+  const auto& garment = suit->garment;
+  const GarmentBinding binding(garment, suit->body_a);
+  const ResizeResult r = binding.resize(suit->body("M_heavier"));
   const nlohmann::json& sym = r.report.at("symmetry");
   EXPECT_TRUE(sym.at("symmetric").get<bool>());
   EXPECT_TRUE(sym.at("symmetrised").get<bool>());

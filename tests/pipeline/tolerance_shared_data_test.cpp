@@ -4,7 +4,7 @@
 // digits. It did (clearance.cpp): the shared skirt on F_thinner moved 0.2-0.5
 // cm between tolerances 1e-6, 1e-7, ... 1e-10, one agent 0.8 cm.
 // Skips when ../shared/data is absent.
-#include "support/test_support.hpp"
+#include "shared_case.hpp"
 
 #include <refit/features/feature_file.hpp>
 #include <refit/io/body_io.hpp>
@@ -19,11 +19,12 @@ namespace refit {
 namespace {
 
 TEST(ToleranceSharedData, TheSkirtConvergesAsTheSolveTightens) {
-  const std::string data = test::shared_data_dir();
-  if (data.empty()) GTEST_SKIP() << "../shared/data is absent: real-data tolerance test skipped";
-  auto skirt = std::make_shared<const Garment>(read_garment_obj(data + "/garments/skirt_on_A_female.obj"));
-  const BodyMesh a = read_body(data + "/bodies/A_female.obj"), b = read_body(data + "/bodies/F_thinner.obj");
-  const auto features = read_feature_file(std::string(REFIT_SOURCE_DIR) + "/bench/quality/features/skirt.json");
+  const auto shared = test::shared_case("skirt");
+  if (!shared) GTEST_SKIP() << "../shared/data is absent: real-data tolerance test skipped";
+  const auto& skirt = shared->garment;
+  const BodyMesh& a = shared->body_a;
+  const std::vector<FeatureSpec>& features = shared->features;
+  const BodyMesh b = shared->body("F_thinner");
   const auto resize = [&](double tolerance) {
     ResizeOptions o;
     o.collision = false;
