@@ -56,7 +56,7 @@ TEST(SymmetrySharedData, OneSidedProfileKeepsSkirtSymmetric) {
                 target, result, warp, r.report.at("surface").at("feature_gap").get<double>(),
                 r.report.at("surface").at("feature_gap_written").get<double>());
     EXPECT_LE(result, warp + 0.1) << target;
-    // The collision step moves both sides alike (GarmentBinding::symmetric_pushes):
+    // The collision step moves both sides alike (GarmentMirror::alike_pushes):
     // pushing each side by what it alone needed left 0.19 cm on F_heavier (warp 0.35).
     EXPECT_LE(result, 0.5 * warp) << target;
     EXPECT_LE(r.report.at("surface").at("feature_gap").get<double>(), 0.05) << target;

@@ -315,7 +315,7 @@ Points symmetrised_move_rows(const RecordFile<MirrorRecord>& mirror, const Point
                              std::size_t first, const Points& b, const Points& a, double tolerance) {
   std::vector<MirrorRecord> rec;
   mirror.read(first, std::size_t(b.rows()), rec);
-  // As GarmentBinding::mirrored_move: the image's move (the offsets cancel), mirrored.
+  // As GarmentMirror::mirrored_move: the image's move (the offsets cancel), mirrored.
   Points mirrored = images(rec, after, tolerance) - images(rec, before, tolerance);
   mirrored.col(0) = -mirrored.col(0);
   Points out = a;

@@ -45,7 +45,7 @@ Points symmetrised_rows(const RecordFile<MirrorRecord>& mirror, const PointGathe
 
 /// Rows [first, first + b.rows()) of `b` (rows of `before`) with each vertex's
 /// move to `a` (rows of `after`) made, where its image is within `tolerance`,
-/// the mean of its own and its image's move, mirrored (GarmentBinding::symmetrise_moves).
+/// the mean of its own and its image's move, mirrored (GarmentMirror::symmetrise_moves).
 Points symmetrised_move_rows(const RecordFile<MirrorRecord>& mirror, const PointGather& before, const PointGather& after,
                              std::size_t first, const Points& b, const Points& a, double tolerance);
 

@@ -143,14 +143,8 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
   }
   const SymmetryCheck sym = check_symmetry(plane_x, mirror_distance, body_a_.mesh().vertices,
                                            options_.symmetry_tolerance_cm * per_cm, options_.symmetry);
-  if (sym.symmetric) {
-    mirror_x_ = sym.plane_x;
-    mirror_tolerance_ = sym.tolerance;
-    garment_mirror_ = std::move(mirror_at);
-    garment_paired_.resize(mirror_distance.size());
-    for (std::size_t i = 0; i < mirror_distance.size(); ++i) garment_paired_[i] = mirror_distance[i] <= sym.tolerance;
-    body_mirror_ = mirror_pairs(body_a_.mesh().vertices, mirror_x_, sym.tolerance);
-  }
+  if (sym.symmetric)
+    mirror_ = GarmentMirror(sym.plane_x, sym.tolerance, std::move(mirror_at), mirror_distance, body_a_.mesh().vertices);
   symmetry_report_ = symmetry_report(sym);
   bind_report_["symmetry"] = clock.ms();
   if (!features.empty()) {
@@ -183,7 +177,7 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
       sm.follow_tolerance = kFeatureFollowToleranceCm * per_cm;
     }
     features_ = bind_features(body_a_, std::move(curves), sm);
-    if (sym.symmetric) feature_mirror_ = sample_mirror_pairs(features_->model.curves, mirror_x_);
+    if (sym.symmetric) feature_mirror_ = sample_mirror_pairs(features_->model.curves, sym.plane_x);
     bind_report_["features"] = clock.ms();
   }
   if (options_.stage == Stage::Full) {
@@ -360,9 +354,8 @@ TriangleFrames GarmentBinding::warp_step(const BodyMesh& body_b, ResizeResult& r
 // Symmetrise only when body B is symmetric too (the same vertices as body A's, mirrored).
 bool GarmentBinding::body_b_symmetric(const BodyMesh& body_b, nlohmann::json& report) const {
   report["symmetry"] = symmetry_report_;
-  if (body_mirror_.empty()) return false;
-  const double body_b_error = paired_mirror_error(body_b.vertices, body_mirror_, mirror_x_);
-  const bool symmetric_b = body_b_error <= mirror_tolerance_;
+  if (!mirror_.active()) return false;
+  const auto [body_b_error, symmetric_b] = mirror_.body_error(body_b.vertices);
   report["symmetry"]["body_b_error"] = body_b_error;
   report["symmetry"]["symmetrised"] = symmetric_b;
   return symmetric_b;
@@ -376,82 +369,6 @@ const Csr& GarmentBinding::vertex_adjacency_once() const {
 const FoldBinding& GarmentBinding::folds_once() const {
   std::call_once(folds_once_, [&] { folds_ = bind_folds(*garment_); });
   return folds_;
-}
-
-// A symmetric pair gives a symmetric garment: each paired vertex halfway to its partner's mirror image.
-void GarmentBinding::symmetrise_garment(Points& positions) const {
-  const Points mirrored = mirror_x(carry(garment_mirror_, positions), mirror_x_);
-  for (Index i = 0; i < positions.rows(); ++i)
-    if (garment_paired_[i]) positions.row(i) = 0.5 * (positions.row(i) + mirrored.row(i));
-}
-
-Vec3 GarmentBinding::mirrored_move(const Points& before, const Points& after, Index i) const {
-  Vec3 m = carry_one(garment_mirror_, after, i) - carry_one(garment_mirror_, before, i);  // the offsets cancel
-  m.x() = -m.x();
-  return m;
-}
-
-// Elsewhere both moves are zero exactly (the same arithmetic on the same rows),
-// so a rule that leaves a vertex with no move and no image's move alone may skip
-// it. Rows are gathered per block, in vertex order.
-template <class Row>
-std::vector<std::pair<Index, Vec3>> GarmentBinding::paired_moving_rows(const Points& before, const Points& after,
-                                                                      const Row& row) const {
-  const std::size_t n = std::size_t(after.rows());
-  std::vector<std::uint8_t> moved(n);
-  parallel_for(0, n, 4096, [&](std::size_t b, std::size_t e) {
-    for (std::size_t v = b; v < e; ++v) moved[v] = after.row(Eigen::Index(v)) != before.row(Eigen::Index(v));
-  });
-  constexpr std::size_t kBlock = 4096;
-  std::vector<std::vector<std::pair<Index, Vec3>>> rows((n + kBlock - 1) / kBlock);
-  parallel_for(0, rows.size(), 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t k = b; k < e; ++k)
-      for (std::size_t v = k * kBlock; v < std::min(n, (k + 1) * kBlock); ++v) {
-        const auto& image = garment_mirror_.vertex[v];
-        if (!garment_paired_[v] || !(moved[v] || moved[image[0]] || moved[image[1]] || moved[image[2]])) continue;
-        if (const std::optional<Vec3> p = row(Index(v))) rows[k].emplace_back(Index(v), *p);
-      }
-  });
-  std::vector<std::pair<Index, Vec3>> out;
-  for (const auto& r : rows) out.insert(out.end(), r.begin(), r.end());
-  return out;
-}
-
-// The snap moves a few thousand vertices of a million: only those and the
-// vertices whose mirror image lies on a face they are corners of are looked at
-// (a row whose own and mirrored moves are both zero stays, as in
-// symmetrised_move_rows).
-void GarmentBinding::symmetrise_moves(const Points& before, Points& positions) const {
-  const auto rows = paired_moving_rows(before, positions, [&](Index i) -> std::optional<Vec3> {
-    const Vec3 own = row3(positions, i) - row3(before, i), other = mirrored_move(before, positions, i);
-    if (own == Vec3::Zero() && other == Vec3::Zero()) return std::nullopt;
-    return Vec3(row3(before, i) + 0.5 * (own + other));
-  });
-  for (const auto& [i, p] : rows) positions.row(i) = p.transpose();
-}
-
-// The collision step pushes each side by what it needs, and neither body B's
-// triangulation nor the garment's mesh is mirror-symmetric, so the two sides of
-// a symmetric pair come out pushed differently (the real dress on a shorter
-// body: mirror error 0.30 cm before the step, 0.41 after). Each paired vertex
-// whose push differs from its mirror image's (mirrored) by more than
-// `tolerance` takes the mean of the two, but moves at most `max_extra` beyond
-// its own push; the collision step then pushes out again whatever that leaves
-// too close. Measured with the quality suite, near-body change (median over all
-// near vertices / over those whose faces the input keeps clear of body A), from
-// 0.58 / 0.34 cm without this: the larger push for both sides 0.69 cm over all;
-// the plain mean 0.56 / 0.38; the capped mean (this) 0.56 / 0.34.
-std::vector<std::pair<Index, Vec3>> GarmentBinding::symmetric_pushes(const Points& before, const Points& after,
-                                                                    double tolerance, double max_extra) const {
-  return paired_moving_rows(before, after, [&](Index i) -> std::optional<Vec3> {
-    const Vec3 push = row3(after, i) - row3(before, i), other = mirrored_move(before, after, i);
-    if (!((other - push).norm() > tolerance)) return std::nullopt;
-    Vec3 to = 0.5 * (push + other);
-    const Vec3 extra = to - push;
-    if (to.squaredNorm() > push.squaredNorm() && extra.norm() > max_extra)
-      to = push + (max_extra / extra.norm()) * extra;  // the side that needed less
-    return Vec3(row3(before, i) + to);
-  });
 }
 
 void GarmentBinding::feature_step(const TriangleFrames& frames_b, const BodySurface& surface_b, bool symmetric_b,
@@ -484,7 +401,7 @@ void GarmentBinding::feature_step(const TriangleFrames& frames_b, const BodySurf
       *features_, frames_b, [&](const Vec3& p) { return surface_b.closest(p).distance; },
       [&](const Vec3& p, double clearance) { return clearance_need(surface_b, p, clearance); }, extra);
   if (symmetric_b && !feature_mirror_.empty()) {
-    symmetrise_curves(curves, feature_mirror_, mirror_x_);
+    symmetrise_curves(curves, feature_mirror_, mirror_.plane_x());
     restore_meetings(features_->model, curves);
   }
   result.report["timings_ms"]["features"] = clock.ms();
@@ -511,7 +428,7 @@ Points GarmentBinding::surface_step(const BodySurface& surface_b, bool symmetric
     const bool snaps = surface_->snaps();
     std::vector<double> snapped;
     if (snaps) snapped = carried_curve_gaps(result.features, carry(feature_attachment_, result.positions));
-    symmetrise_garment(result.positions);
+    mirror_.symmetrise(result.positions);
     // The mean with the mirror image is carried on the other side's faces; on a
     // mesh that is not mirror-symmetric that bends the garment off the curves
     // the snap reached (the real outfit on F_thinner: 0.046 -> 0.053 cm, 0.072
@@ -534,7 +451,7 @@ Points GarmentBinding::surface_step(const BodySurface& surface_b, bool symmetric
       if (farther_off(snapped, symmetrised)) {
         const Points before = result.positions;  // a copy of the garment only when the snap runs
         surface_->snap(result.positions, feature_targets, s.kept);
-        symmetrise_moves(before, result.positions);
+        mirror_.symmetrise_moves(before, result.positions);
         closer = closer_to_curves(symmetrised,
                                   carried_curve_gaps(result.features, carry(feature_attachment_, result.positions)),
                                   kNegligibleGapChangeCm * units_per_cm(options_.units));
@@ -587,7 +504,7 @@ void GarmentBinding::collision_step(const BodySurface& surface_b, bool symmetric
   // read off the mirror face, and on a split mesh that turned slivers over
   // again (the 1M dress on F_thinner: 25 faces after the smoothing left 4).
   const Points before = symmetric_b ? result.positions : Points();
-  auto alike = [&](const Points& now) { return symmetric_pushes(before, now, kSymmetricPushToleranceCm * per_cm, co.max_lift); };
+  auto alike = [&](const Points& now) { return mirror_.alike_pushes(before, now, kSymmetricPushToleranceCm * per_cm, co.max_lift); };
   // With a symmetric pair twice: the round after the first pass pushes out on
   // one side what the capped means left too close (the shared skirt on
   // F_heavier: 0.20 cm out of symmetry after one pass, 0.09 after two).

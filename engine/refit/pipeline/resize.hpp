@@ -16,6 +16,7 @@
 #include <refit/features/shape_matching.hpp>
 #include <refit/features/symmetry.hpp>
 #include <refit/metrics/metrics.hpp>
+#include <refit/pipeline/garment_mirror.hpp>
 #include <refit/surface/folds.hpp>
 #include <refit/surface/surface.hpp>
 #include <refit/warp/warp.hpp>
@@ -118,31 +119,15 @@ class GarmentBinding {
                       const Progress& progress) const;  // returns the features where the surface step leaves them
   void collision_step(const BodySurface& surface_b, bool symmetric_b, ResizeResult& result,
                       const Progress& progress) const;
-  std::vector<std::pair<Index, Vec3>> symmetric_pushes(const Points& before, const Points& after, double tolerance,
-                                                      double max_extra) const;
   void metrics_step(const BodySurface& surface_b, ResizeResult& result, const Progress& progress) const;
-  void symmetrise_garment(Points& positions) const;
-  /// Vertex i's mirror image's move (carried on the garment's faces) from `before` to `after`, mirrored
-  /// about the plane; meaningful where the vertex is paired.
-  Vec3 mirrored_move(const Points& before, const Points& after, Index i) const;
-  /// The paired vertices whose own move from `before` to `after` or whose image's may
-  /// not be zero (it or a corner of its image's face moved), with `row(i)` of each,
-  /// in vertex order: a collision step or a snap moves a few of a million vertices.
-  template <class Row>
-  std::vector<std::pair<Index, Vec3>> paired_moving_rows(const Points& before, const Points& after, const Row& row) const;
-  /// Each paired vertex's move from `before` to `positions` becomes the mean of its own and its image's, mirrored.
-  void symmetrise_moves(const Points& before, Points& positions) const;
   const Csr& vertex_adjacency_once() const;
   const FoldBinding& folds_once() const;
 
   std::shared_ptr<const Garment> garment_;
   ResizeOptions options_;
   nlohmann::json symmetry_report_;
+  GarmentMirror mirror_;               // inactive unless the garment and body A are mirror-symmetric
   std::vector<Index> feature_mirror_;  // per feature sample (all curves, in order): its mirror partner, or kNoMirror
-  SurfaceAttachment garment_mirror_;   // per garment vertex, its mirror image on the garment's surface
-  std::vector<std::uint8_t> garment_paired_;  // ... when that image is within the symmetry tolerance
-  std::vector<Index> body_mirror_;     // per body A vertex, the same: checks that body B is symmetric too
-  double mirror_x_ = 0.0, mirror_tolerance_ = 0.0;
   ReferenceBody body_a_;
   WarpBinding warp_;
   std::optional<FeatureBinding> features_;
