@@ -111,9 +111,9 @@ TEST(FeatureSnap, TheCarriedSamplesReachTheirTargetsAndOnlyNearbyVerticesMove) {
 
 TEST(FeatureSnap, HeldVerticesStayAndTheSamplesOnThemStayToo) {
   const Sheet s = sheet();
-  std::vector<std::uint8_t> held(s.garment.vertex_count(), 0);
+  std::vector<float> held(s.garment.vertex_count(), 0.0f);
   for (int i = 0; i <= 6; ++i)
-    for (int k = 0; k < kGridSide; ++k) held[i * kGridSide + k] = 1;  // x <= 6
+    for (int k = 0; k < kGridSide; ++k) held[i * kGridSide + k] = 1.0f;  // x <= 6
   Points p = s.garment.positions;
   const Points targets = lifted(s.samples);
   const FeatureSnapReport rep = snap_to_features(p, targets, s.at, s.reach, s.weight, s.feature_of, held, 1e-3);

@@ -417,6 +417,13 @@ const Register resize_command("resize", "Resize a garment from body A to one or 
       ->capture_default_str()
       ->check(CLI::Range(0, 16))
       ->group(kAdvanced);
+  app.add_option("--zone-edge-blend", a->surface.zone_edge_blend,
+                 "Where the feature zone meets the vertices kept at the warp near body B, a vertex takes the warp by "
+                 "its blend's share outside the zone, eased over shares 0.5 +- this (0 = all or nothing by its nearest "
+                 "agent: a cliff one edge wide on a fine mesh)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.5))
+      ->group(kAdvanced);
   app.add_option("--snap-radius", a->surface.snap_radius,
                  "The snap through the features moves the vertices within this many voxels of each feature sample "
                  "(0 = through the reconstruction's blend weights, which can miss a sample's own corners)")

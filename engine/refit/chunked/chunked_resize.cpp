@@ -281,6 +281,7 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
         Index vertex;
         std::int32_t feature;
         float weight;
+        float held;  // the vertex's share of the warp (SurfaceResult::held)
       };
       RecordFile<SnapTerm> snap_terms(plan_.folder);
       std::size_t snap_count = 0;
@@ -302,8 +303,8 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
           const auto lo = std::lower_bound(bound_->carries_feature.begin(), bound_->carries_feature.end(), Index(first));
           for (auto it = lo; it != bound_->carries_feature.end() && *it < first + carries.size(); ++it) carries[*it - first] = 1;
         }
-        std::vector<std::uint8_t> kept;
-        const Points s = surface.emit_vertices(sol, original, w, blends, carries, near, kept, st);
+        std::vector<float> held_share;
+        const Points s = surface.emit_vertices(sol, original, w, blends, carries, near, held_share, st);
         surfaced->write(first, s);
         if (!snaps) return;
         // The snap's reach: its own (snap_radius > 0) or the blends', as SurfaceBinding::snap takes it.
@@ -312,7 +313,7 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
         const Csr& reach = kernel ? own_reach.reach : blends.reach;
         const std::vector<float>& weight = kernel ? own_reach.weight : blends.weight;
         any_weight = any_weight || !weight.empty();
-        const auto held = [&](std::size_t i) { return !kept.empty() && kept[i]; };
+        const auto held = [&](std::size_t i) { return held_share.empty() ? 0.0f : held_share[i]; };
         const auto lo = std::lower_bound(sample_vertices.begin(), sample_vertices.end(), Index(first));
         for (auto it = lo; it != sample_vertices.end() && *it < first + std::size_t(s.rows()); ++it) {
           const std::size_t i = *it - first;
@@ -325,11 +326,11 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
         }
         std::vector<SnapTerm> terms;
         for (std::size_t i = 0; i < std::size_t(s.rows()); ++i) {
-          if (held(i) || weight.empty()) continue;
+          if (held(i) >= 1.0f || weight.empty()) continue;
           const auto r = reach.row(i);
           for (std::size_t q = 0; q < r.size(); ++q)
             if (surface.feature_of()[r[q]] >= 0)
-              terms.push_back({Index(first + i), surface.feature_of()[r[q]], weight[reach.offsets[i] + q]});
+              terms.push_back({Index(first + i), surface.feature_of()[r[q]], weight[reach.offsets[i] + q], held(i)});
         }
         snap_terms.write(snap_count, std::span<const SnapTerm>(terms));
         snap_count += terms.size();
@@ -355,7 +356,8 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
               }
               const SnapTerm& t = batch[taken];
               if (t.vertex >= end) break;
-              s.row(Eigen::Index(t.vertex - first)) += double(kernel.weight(t.weight, t.feature)) * snap.correction.row(t.feature);
+              s.row(Eigen::Index(t.vertex - first)) +=
+                  (1.0 - double(t.held)) * double(kernel.weight(t.weight, t.feature)) * snap.correction.row(t.feature);
               moved += t.vertex != previous;
               previous = t.vertex;
               ++taken;
@@ -363,10 +365,11 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
             file.write(first, s);
           });
           for (auto& [v, sv] : snap_vertices) {
-            if (sv.held || sv.weight.empty()) continue;
+            if (sv.held >= 1.0f || sv.weight.empty()) continue;
             for (std::size_t q = 0; q < sv.reach.size(); ++q) {
               const std::int32_t f = surface.feature_of()[sv.reach[q]];
-              if (f >= 0) sv.position += double(kernel.weight(sv.weight[q], f)) * snap.correction.row(f).transpose();
+              if (f >= 0)
+                sv.position += (1.0 - double(sv.held)) * double(kernel.weight(sv.weight[q], f)) * snap.correction.row(f).transpose();
             }
           }
           return moved;

@@ -450,7 +450,7 @@ Points GarmentBinding::surface_step(const BodySurface& surface_b, bool symmetric
       bool closer = false;
       if (farther_off(snapped, symmetrised)) {
         const Points before = result.positions;  // a copy of the garment only when the snap runs
-        surface_->snap(result.positions, feature_targets, s.kept);
+        surface_->snap(result.positions, feature_targets, s.held);
         mirror_.symmetrise_moves(before, result.positions);
         closer = closer_to_curves(symmetrised,
                                   carried_curve_gaps(result.features, carry(feature_attachment_, result.positions)),

@@ -19,10 +19,10 @@ Vec3 carried(const SurfaceAttachment& at, const SnapVertices& vs, Index k, const
   for (int j = 0; j < 3; ++j) {
     const SnapVertex& v = vs.at(at.vertex[s][j]);
     Vec3 p = v.position;
-    if (snap && !v.held)
+    if (snap && v.held < 1.0f)
       for (std::size_t r = 0; r < v.reach.size(); ++r) {
         const std::int32_t f = (*feature_of)[v.reach[r]];
-        if (f >= 0) p += (double(kernel.weight(v.weight[r], f)) * snap->correction.row(f)).transpose();
+        if (f >= 0) p += ((1.0 - double(v.held)) * double(kernel.weight(v.weight[r], f)) * snap->correction.row(f)).transpose();
       }
     q += at.weight[s][j] * p;
   }
@@ -32,7 +32,7 @@ Vec3 carried(const SurfaceAttachment& at, const SnapVertices& vs, Index k, const
 std::vector<std::uint8_t> samples_on_held(const SurfaceAttachment& at, const SnapVertices& vs, std::size_t nf) {
   std::vector<std::uint8_t> on_held(nf, 0);
   for (std::size_t k = 0; k < nf; ++k)
-    for (int j = 0; j < 3; ++j) on_held[k] |= at.weight[k][j] != 0.0 && vs.at(at.vertex[k][j]).held;
+    for (int j = 0; j < 3; ++j) on_held[k] |= at.weight[k][j] != 0.0 && vs.at(at.vertex[k][j]).held >= 1.0f;
   return on_held;
 }
 
@@ -71,7 +71,7 @@ SnapKernel narrowed_kernel(const SurfaceAttachment& at, const SnapVertices& vs, 
     for (int j = 0; j < 3; ++j) {
       if (at.weight[k][j] == 0.0) continue;
       const SnapVertex& v = vs.at(at.vertex[k][j]);
-      if (v.held) continue;
+      if (v.held >= 1.0f) continue;
       double d = 1.0;  // a corner out of the agent's reach: the whole radius
       for (std::size_t r = 0; r < v.reach.size() && r < v.weight.size(); ++r)
         if (feature_of[v.reach[r]] == std::int32_t(k)) d = std::sqrt(std::max(0.0, 1.0 - std::sqrt(double(v.weight[r]))));
@@ -102,9 +102,10 @@ FeatureSnap solve_feature_snap(const Points& targets, const SurfaceAttachment& a
       const Index v = at.vertex[std::size_t(k)][j];
       const double w = at.weight[std::size_t(k)][j];
       const SnapVertex& sv = vs.at(v);
-      if (w == 0.0 || sv.held) continue;
+      if (w == 0.0 || sv.held >= 1.0f) continue;
       for (std::size_t q = 0; q < sv.reach.size(); ++q)
-        if (const std::int32_t f = feature_of[sv.reach[q]]; f >= 0) entries.emplace_back(k, f, w * kernel.weight(sv.weight[q], f));
+        if (const std::int32_t f = feature_of[sv.reach[q]]; f >= 0)
+          entries.emplace_back(k, f, (1.0 - double(sv.held)) * w * kernel.weight(sv.weight[q], f));
     }
   }
   Eigen::SparseMatrix<double> a(nf, nf);
@@ -126,18 +127,19 @@ FeatureSnap solve_feature_snap(const Points& targets, const SurfaceAttachment& a
 
 std::size_t apply_feature_snap(const FeatureSnap& snap, Points& positions, const Csr& reach,
                                const std::vector<float>& reach_weight, const std::vector<std::int32_t>& feature_of,
-                               std::span<const std::uint8_t> held, const SnapKernel& kernel) {
+                               std::span<const float> held, const SnapKernel& kernel) {
   if (snap.correction.size() == 0) return 0;
   const Eigen::MatrixXd& c = snap.correction;
   std::vector<std::uint8_t> moved(positions.rows(), 0);
   parallel_for(0, std::size_t(positions.rows()), 4096, [&](std::size_t b, std::size_t e) {
     for (std::size_t v = b; v < e; ++v) {
-      if (!held.empty() && held[v]) continue;
+      const double free = held.empty() ? 1.0 : 1.0 - double(held[v]);
+      if (!(free > 0.0)) continue;
       auto r = reach.row(v);
       for (std::size_t q = 0; q < r.size(); ++q) {
         const std::int32_t f = feature_of[r[q]];
         if (f < 0) continue;
-        positions.row(Eigen::Index(v)) += double(kernel.weight(reach_weight[reach.offsets[v] + q], f)) * c.row(f);
+        positions.row(Eigen::Index(v)) += free * double(kernel.weight(reach_weight[reach.offsets[v] + q], f)) * c.row(f);
         moved[v] = 1;
       }
     }
@@ -155,7 +157,7 @@ double snapped_gap(const FeatureSnap& snap, const Points& targets, const Surface
 
 FeatureSnapReport snap_to_features(Points& positions, const Points& targets, const SurfaceAttachment& at,
                                    const Csr& reach, const std::vector<float>& reach_weight,
-                                   const std::vector<std::int32_t>& feature_of, const std::vector<std::uint8_t>& held,
+                                   const std::vector<std::int32_t>& feature_of, const std::vector<float>& held,
                                    double regularisation, double narrow) {
   SnapVertices vs;
   for (const auto& corners : at.vertex)
@@ -163,7 +165,7 @@ FeatureSnapReport snap_to_features(Points& positions, const Points& targets, con
       if (vs.count(v)) continue;
       SnapVertex& sv = vs[v];
       sv.position = row3(positions, v);
-      sv.held = !held.empty() && held[v];
+      sv.held = held.empty() ? 0.0f : held[v];
       const auto r = reach.row(v);
       sv.reach.assign(r.begin(), r.end());
       if (!reach_weight.empty())

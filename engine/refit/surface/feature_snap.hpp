@@ -33,14 +33,14 @@ namespace refit {
 struct FeatureSnapReport {
   double gap_before = 0.0;       // largest distance from a carried feature sample to its target (samples not on a
   double gap_after = 0.0;        // held vertex), before and after the correction (what remains: samples in conflict)
-  std::size_t samples_held = 0;  // samples on a held vertex: they stay where they are
+  std::size_t samples_held = 0;  // samples on a (wholly) held vertex: they stay where they are
   std::size_t vertices_moved = 0;
 };
 
 /// A vertex a feature sample sits on, as the snap sees it.
 struct SnapVertex {
   Vec3 position = Vec3::Zero();  // after the reconstruction
-  bool held = false;             // must not move
+  float held = 0.0f;             // the share of the correction it does not take (1: must not move)
   std::vector<Index> reach;      // its agents within reach
   std::vector<float> weight;     // ... and their blend weights
 };
@@ -74,10 +74,11 @@ FeatureSnap solve_feature_snap(const Points& targets, const SurfaceAttachment& a
                                const SnapKernel& kernel = {});
 
 /// Moves rows of `positions` (all vertices or a chunk; `reach`, `reach_weight`
-/// and `held` theirs) by the corrections; returns how many moved.
+/// and `held` theirs) by the corrections, each vertex by the share it is not
+/// held; returns how many moved.
 std::size_t apply_feature_snap(const FeatureSnap& snap, Points& positions, const Csr& reach,
                                const std::vector<float>& reach_weight, const std::vector<std::int32_t>& feature_of,
-                               std::span<const std::uint8_t> held, const SnapKernel& kernel = {});
+                               std::span<const float> held, const SnapKernel& kernel = {});
 
 /// Largest distance from a carried sample to its target over the samples not
 /// on a held vertex, with the sample vertices moved by the corrections.
@@ -87,13 +88,14 @@ double snapped_gap(const FeatureSnap& snap, const Points& targets, const Surface
 /// Corrects `positions` (every garment vertex) so that the feature samples
 /// attached by `attachment` reach `targets`. `reach`/`reach_weight`: each
 /// vertex's agents and their weights (the snap reach or the blends, above); `feature_of`: per agent, its
-/// feature sample or -1; `held`: vertices that must not move (empty: none).
+/// feature sample or -1; `held`: per vertex, the share of its correction it
+/// does not take (1: must not move; empty: none held).
 /// `regularisation`: Tikhonov weight relative to the mean diagonal of the
 /// normal equations. `narrow`: the kernel narrowed to this share (narrowed_kernel;
 /// 1: the weights as given). Deterministic for any thread count.
 FeatureSnapReport snap_to_features(Points& positions, const Points& targets, const SurfaceAttachment& attachment,
                                    const Csr& reach, const std::vector<float>& reach_weight,
-                                   const std::vector<std::int32_t>& feature_of, const std::vector<std::uint8_t>& held,
+                                   const std::vector<std::int32_t>& feature_of, const std::vector<float>& held,
                                    double regularisation, double narrow = 1.0);
 
 }  // namespace refit

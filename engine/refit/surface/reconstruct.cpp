@@ -188,46 +188,65 @@ std::vector<Eigen::Matrix3d> SurfaceBinding::rotations(const Points& before, con
 
 Points SurfaceBinding::emit_vertices(const AgentSolution& sol, const Points& original, const Points& warped,
                                      const VertexBlends& blends, std::span<const std::uint8_t> carries_feature,
-                                     const NearBody& near_body_b, std::vector<std::uint8_t>& kept,
+                                     const NearBody& near_body_b, std::vector<float>& held,
                                      SurfaceStats& stats) const {
-  kept.clear();
+  held.clear();
   if (agent_count() == 0) return warped;
   const bool orig = options_.emit_from_original && !options_.encode_on_warped;
   Points out = reconstruct_rotations(orig ? original : warped, orig ? original_agents_ : sol.before, sol.x, sol.rotation,
                                      blends.reach, blends.weight, blends.nearest, sol.keep, &warped);
   if (options_.keep_near_vertices) {
-    kept = keep_near_vertices(sol, warped, blends, carries_feature, near_body_b, out);
-    stats.vertices_kept += std::accumulate(kept.begin(), kept.end(), std::size_t{0});
+    held = keep_near_vertices(sol, warped, blends, carries_feature, near_body_b, out);
+    stats.vertices_kept += std::size_t(std::count(held.begin(), held.end(), 1.0f));
   }
   return out;
 }
 
 // Eq. 14 for the vertices too: blending frames of nearby free agents must not
 // pull a vertex that touches the body. Only vertices the nearest agent's
-// distance cannot rule out are queried: d(v) >= d(a) - |v - a|.
-std::vector<std::uint8_t> SurfaceBinding::keep_near_vertices(const AgentSolution& sol, const Points& warped,
-                                                             const VertexBlends& blends,
-                                                             std::span<const std::uint8_t> carries_feature,
-                                                             const NearBody& near_body_b,
-                                                             Points& positions) const {
+// distance cannot rule out are queried: d(v) >= d(a) - |v - a|. Next to the
+// feature zone a vertex takes the warp only by its blend's share outside the
+// zone (SurfaceOptions::zone_edge_blend): the blend weights vary smoothly with
+// the vertex, so the zone's edge is a slope at any mesh resolution.
+std::vector<float> SurfaceBinding::keep_near_vertices(const AgentSolution& sol, const Points& warped,
+                                                      const VertexBlends& blends,
+                                                      std::span<const std::uint8_t> carries_feature,
+                                                      const NearBody& near_body_b, Points& positions) const {
   const std::size_t nv = static_cast<std::size_t>(warped.rows());
   const Points& before = sol.before;
   const std::vector<double>& body_distance = sol.body_distance;
-  std::vector<std::uint8_t> kept(nv, 0);
+  const bool zone = !near_feature_.empty();
+  const double blend = options_.zone_edge_blend;
+  const bool eased = zone && blend > 0.0 && !blends.weight.empty();
+  // How much of the warp vertex v takes: all or nothing by its nearest agent, or eased by its share outside the zone.
+  const auto warp_share = [&](std::size_t v) {
+    if (!eased) return zone && near_feature_[blends.nearest[v]] ? 0.0 : 1.0;
+    double outside = 0.0;
+    for (std::size_t j = blends.reach.offsets[v]; j < blends.reach.offsets[v + 1]; ++j)
+      if (!near_feature_[blends.reach.indices[j]]) outside += blends.weight[j];
+    if (outside >= 0.5 + blend - 1e-6) return 1.0;  // the weights' float sum: all outside is all
+    const double t = std::clamp((outside - (0.5 - blend)) / (2.0 * blend), 0.0, 1.0);
+    return t * t * (3.0 - 2.0 * t);
+  };
+  std::vector<float> held(nv, 0.0f);
   parallel_for(0, nv, 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t v = b; v < e; ++v) {
       const Index a = blends.nearest[v];
-      if (!near_feature_.empty() && (near_feature_[a] || carries_feature[v])) continue;
+      if (zone && carries_feature[v]) continue;
       if (!sol.banded.empty() && sol.banded[a]) continue;
+      const double share = warp_share(v);
+      if (!(share > 0.0)) continue;
       const Vec3 p = row3(warped, Index(v));
       if (feature_of_[a] < 0 && body_distance[a] - (p - row3(before, a)).norm() >= options_.epsilon) continue;
-      if (near_body_b(p)) {
+      if (!near_body_b(p)) continue;
+      if (share < 1.0)
+        positions.row(Eigen::Index(v)) += share * (warped.row(Eigen::Index(v)) - positions.row(Eigen::Index(v)));
+      else
         positions.row(Eigen::Index(v)) = warped.row(Eigen::Index(v));
-        kept[v] = 1;
-      }
+      held[v] = float(share);
     }
   });
-  return kept;
+  return held;
 }
 
 }  // namespace refit

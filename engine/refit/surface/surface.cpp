@@ -198,13 +198,13 @@ SurfaceResult SurfaceBinding::apply(const Points& warped, const Points& targets,
   res.stats = sol.stats;
   SurfaceStats& st = res.stats;
   clock.reset();
-  std::vector<std::uint8_t> kept_vertex;
-  res.positions = emit_vertices(sol, original_vertices_, warped, blends_, carries_feature_, near, kept_vertex, st);
-  const FeatureSnapReport snapped = snap(res.positions, targets, kept_vertex);
+  std::vector<float> held;
+  res.positions = emit_vertices(sol, original_vertices_, warped, blends_, carries_feature_, near, held, st);
+  const FeatureSnapReport snapped = snap(res.positions, targets, held);
   st.feature_gap_before_snap = snapped.gap_before;
   st.feature_gap = snapped.gap_after;
   st.vertices_snapped = snapped.vertices_moved;
-  res.kept = std::move(kept_vertex);
+  res.held = std::move(held);
   res.agents = std::move(sol.x);
   st.ms.reconstruct = clock.ms();
   return res;
@@ -433,7 +433,7 @@ SurfaceBinding::AgentSolution SurfaceBinding::solve_agents(Points before_in, con
   return sol;
 }
 
-FeatureSnapReport SurfaceBinding::snap(Points& positions, const Points& targets, const std::vector<std::uint8_t>& held,
+FeatureSnapReport SurfaceBinding::snap(Points& positions, const Points& targets, const std::vector<float>& held,
                                        int passes) const {
   FeatureSnapReport total;
   if (!snaps()) return total;

@@ -59,6 +59,12 @@ struct SurfaceOptions {
                                    // feature agents), under which a feature running within epsilon of the body (the side
                                    // seams of a tight dress) mostly stays as warped. The clearance rounds and the
                                    // collision step still keep the zone off the body. At most 16
+  double zone_edge_blend = 0.3;    // beyond the paper: where the feature zone meets eq. 14's vertices, a vertex within
+                                   // epsilon of body B takes its warped position by the share of its blend weights on
+                                   // agents outside the zone, eased (smoothstep) from 0 at a share of 0.5 minus this to
+                                   // 1 at 0.5 plus this. The zone's reconstruction stands a few mm off the warp, and
+                                   // all or nothing (by the nearest agent) made that a cliff one edge wide on a fine
+                                   // mesh (the 1M dress's side profiles: a jagged ridge). 0: all or nothing; at most 0.5
   double feature_bend_radius = 16.0;  // beyond the paper: within about this distance of a feature (one-ring steps of
                                    // the voxel size h; garment units, the pipeline passes cm) the surface is solved again
                                    // in least squares over eq. 13's rows and the feature agents' own, so it leaves a
@@ -164,7 +170,8 @@ struct SurfaceStats {
 struct SurfaceResult {
   Points positions;                 // every garment vertex
   Points agents;                    // optimised agent positions (storage order)
-  std::vector<std::uint8_t> kept;   // per vertex: kept at its warped position (the snap leaves it; empty: none)
+  std::vector<float> held;          // per vertex: the share of its warped position it keeps near body B (1: kept at the
+                                    // warp, which the snap leaves; between: the zone's edge, whose snap moves shrink so)
   SurfaceStats stats;
 };
 
@@ -282,10 +289,10 @@ class SurfaceBinding {
   /// apply's re-emission of vertices (all, or a chunk: `original` and `warped`
   /// their rows, `blends` theirs), with eq. 14 for those touching body B
   /// (`carries_feature`: per row, a corner of a face a feature sample sits on;
-  /// empty without a zone). Adds to out.kept (per row) and the stats.
+  /// empty without a zone). Sets `held` (per row, as SurfaceResult::held) and adds to the stats.
   Points emit_vertices(const AgentSolution& solution, const Points& original, const Points& warped,
                        const VertexBlends& blends, std::span<const std::uint8_t> carries_feature,
-                       const NearBody& near_body_b, std::vector<std::uint8_t>& kept, SurfaceStats& stats) const;
+                       const NearBody& near_body_b, std::vector<float>& held, SurfaceStats& stats) const;
   /// The signed distance to body B that apply(..., body_b, ...) uses (bounded a little beyond epsilon).
   std::function<double(const Vec3&)> body_distance(const BodySurface& body_b) const;
   /// Whether a point is within epsilon of body B or inside it: body_distance's
@@ -325,10 +332,10 @@ class SurfaceBinding {
                       const Points* feature_warped = nullptr, SurfaceSystem* system = nullptr) const;
 
   /// The last step of apply on its own: moves `positions` (every vertex) so the
-  /// feature samples reach `feature_targets` (feature_snap.hpp), leaving `held`
-  /// vertices (those apply keeps at their warped positions) alone. Zero report
+  /// feature samples reach `feature_targets` (feature_snap.hpp), leaving the
+  /// `held` share of each vertex (SurfaceResult::held) where it is. Zero report
   /// without a zone. `passes`: at most this many corrections (0: SurfaceOptions::snap_passes).
-  FeatureSnapReport snap(Points& positions, const Points& feature_targets, const std::vector<std::uint8_t>& held,
+  FeatureSnapReport snap(Points& positions, const Points& feature_targets, const std::vector<float>& held,
                          int passes = 0) const;
 
   /// Eq. 13 on the fine agents (rows() encoding) with right-hand side h, from x
@@ -374,9 +381,9 @@ class SurfaceBinding {
                               std::vector<std::uint8_t>& anchored_kept) const;
   void smooth_displacements(const Points& before, const std::vector<std::uint8_t>& fr, Points& x) const;
   std::vector<Eigen::Matrix3d> rotations(const Points& before, const Points& x, const std::vector<Eigen::Matrix3d>& stretch) const;
-  std::vector<std::uint8_t> keep_near_vertices(const AgentSolution& solution, const Points& warped,
-                                               const VertexBlends& blends, std::span<const std::uint8_t> carries_feature,
-                                               const NearBody& near_body_b, Points& positions) const;
+  std::vector<float> keep_near_vertices(const AgentSolution& solution, const Points& warped,
+                                        const VertexBlends& blends, std::span<const std::uint8_t> carries_feature,
+                                        const NearBody& near_body_b, Points& positions) const;
   SurfaceResult apply(const Points& warped_vertices, const Points& feature_targets,
                       const std::function<double(const Vec3&)>& distance_to_body_b, const NearBody& near_body_b,
                       const Points* feature_warped, SurfaceSystem* system) const;
