@@ -254,7 +254,14 @@ TEST(Cli, UsageErrorsExitTwoAndHelpDocumentsExitCodes) {
                                  "resize --garment g.obj --from a.obj --to b.obj --out o.obj --clearance inf",
                                  "resize --garment g.obj --from a.obj --to b.obj --out o.obj --clearance 1e6",
                                  "resize --garment g.obj --from a.obj --to b.obj --out o.obj --snap-remainder 0",
-                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --snap-remainder 1.5"}) {
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --snap-remainder 1.5",
+                                 // Number options take finite values only (CLI11's ranges let NaN through).
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --feature-bend nan",
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --near-body-band nan",
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --zone-edge-blend nan",
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --epsilon inf",
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --snap-radius 1e400",
+                                 "flatten --garment g.obj --out-dir p --dart-target nan"}) {
     SCOPED_TRACE(args);
     EXPECT_EQ(run_cli(args).exit_code, 2);
   }

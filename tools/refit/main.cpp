@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -72,9 +73,20 @@ int main(int argc, char** argv) {
   auto& commands = registry();
   std::sort(commands.begin(), commands.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
   std::vector<std::pair<CLI::App*, std::function<int()>>> actions;
+  // CLI11 reads "nan" and "inf" as numbers and its ranges let NaN through: every
+  // number option of every command takes finite values only.
+  const CLI::Validator finite(
+      [](std::string& value) {
+        char* end = nullptr;
+        const double v = std::strtod(value.c_str(), &end);
+        return end != value.c_str() && !std::isfinite(v) ? "Value " + value + " is not a finite number" : std::string();
+      },
+      "");
   for (auto& c : commands) {
     CLI::App* sub = app.add_subcommand(c.name, c.description);
     actions.emplace_back(sub, c.setup(*sub));
+    for (CLI::Option* option : sub->get_options())
+      if (option->get_type_name().rfind("FLOAT", 0) == 0) option->transform(finite);  // first: before its range
   }
   try {
     app.parse(argc, argv);
