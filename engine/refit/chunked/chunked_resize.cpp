@@ -356,8 +356,7 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
               }
               const SnapTerm& t = batch[taken];
               if (t.vertex >= end) break;
-              s.row(Eigen::Index(t.vertex - first)) +=
-                  (1.0 - double(t.held)) * double(kernel.weight(t.weight, t.feature)) * snap.correction.row(t.feature);
+              s.row(Eigen::Index(t.vertex - first)) += kernel.share(t.weight, t.feature, t.held) * snap.correction.row(t.feature);
               moved += t.vertex != previous;
               previous = t.vertex;
               ++taken;
@@ -368,8 +367,7 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
             if (sv.held >= 1.0f || sv.weight.empty()) continue;
             for (std::size_t q = 0; q < sv.reach.size(); ++q) {
               const std::int32_t f = surface.feature_of()[sv.reach[q]];
-              if (f >= 0)
-                sv.position += (1.0 - double(sv.held)) * double(kernel.weight(sv.weight[q], f)) * snap.correction.row(f).transpose();
+              if (f >= 0) sv.position += kernel.share(sv.weight[q], f, sv.held) * snap.correction.row(f).transpose();
             }
           }
           return moved;

@@ -22,7 +22,7 @@ Vec3 carried(const SurfaceAttachment& at, const SnapVertices& vs, Index k, const
     if (snap && v.held < 1.0f)
       for (std::size_t r = 0; r < v.reach.size(); ++r) {
         const std::int32_t f = (*feature_of)[v.reach[r]];
-        if (f >= 0) p += ((1.0 - double(v.held)) * double(kernel.weight(v.weight[r], f)) * snap->correction.row(f)).transpose();
+        if (f >= 0) p += (kernel.share(v.weight[r], f, v.held) * snap->correction.row(f)).transpose();
       }
     q += at.weight[s][j] * p;
   }
@@ -105,7 +105,7 @@ FeatureSnap solve_feature_snap(const Points& targets, const SurfaceAttachment& a
       if (w == 0.0 || sv.held >= 1.0f) continue;
       for (std::size_t q = 0; q < sv.reach.size(); ++q)
         if (const std::int32_t f = feature_of[sv.reach[q]]; f >= 0)
-          entries.emplace_back(k, f, (1.0 - double(sv.held)) * w * kernel.weight(sv.weight[q], f));
+          entries.emplace_back(k, f, w * kernel.share(sv.weight[q], f, sv.held));
     }
   }
   Eigen::SparseMatrix<double> a(nf, nf);
@@ -133,13 +133,13 @@ std::size_t apply_feature_snap(const FeatureSnap& snap, Points& positions, const
   std::vector<std::uint8_t> moved(positions.rows(), 0);
   parallel_for(0, std::size_t(positions.rows()), 4096, [&](std::size_t b, std::size_t e) {
     for (std::size_t v = b; v < e; ++v) {
-      const double free = held.empty() ? 1.0 : 1.0 - double(held[v]);
-      if (!(free > 0.0)) continue;
+      const float h = held.empty() ? 0.0f : held[v];
+      if (!(h < 1.0f)) continue;
       auto r = reach.row(v);
       for (std::size_t q = 0; q < r.size(); ++q) {
         const std::int32_t f = feature_of[r[q]];
         if (f < 0) continue;
-        positions.row(Eigen::Index(v)) += free * double(kernel.weight(reach_weight[reach.offsets[v] + q], f)) * c.row(f);
+        positions.row(Eigen::Index(v)) += kernel.share(reach_weight[reach.offsets[v] + q], f, h) * c.row(f);
         moved[v] = 1;
       }
     }

@@ -52,6 +52,11 @@ using SnapVertices = std::unordered_map<Index, SnapVertex>;
 struct SnapKernel {
   std::vector<double> scale;
   float weight(float w, std::int32_t feature) const;
+  /// How much of feature sample `feature`'s correction a vertex with blend
+  /// weight `w` takes when it is `held` (SnapVertex::held) where it is.
+  double share(float w, std::int32_t feature, float held) const {
+    return (1.0 - double(held)) * double(weight(w, feature));
+  }
 };
 
 /// The narrowed kernel of the passes after the first: per feature sample, the

@@ -234,11 +234,10 @@ std::vector<float> SurfaceBinding::keep_near_vertices(const AgentSolution& sol, 
       const Index a = blends.nearest[v];
       if (zone && carries_feature[v]) continue;
       if (!sol.banded.empty() && sol.banded[a]) continue;
-      const double share = warp_share(v);
-      if (!(share > 0.0)) continue;
       const Vec3 p = row3(warped, Index(v));
       if (feature_of_[a] < 0 && body_distance[a] - (p - row3(before, a)).norm() >= options_.epsilon) continue;
-      if (!near_body_b(p)) continue;
+      const double share = warp_share(v);
+      if (!(share > 0.0) || !near_body_b(p)) continue;
       if (share < 1.0)
         positions.row(Eigen::Index(v)) += share * (warped.row(Eigen::Index(v)) - positions.row(Eigen::Index(v)));
       else
