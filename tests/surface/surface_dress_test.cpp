@@ -201,6 +201,7 @@ TEST(SurfaceDress, TheFeatureZoneLetsTheFeaturesWinNearThemAndSnapsTheGarmentThr
   SurfaceOptions zoned;
   ASSERT_EQ(zoned.feature_zone_rings, 1);
   zoned.near_body_band = 0.0;
+  zoned.feature_slide_rings = 0;  // the zone alone (the slide beside it: BesideAFeatureTheKeptSurfaceBeginsRingsAway)
   SurfaceOptions paper_rule = zoned;
   paper_rule.feature_zone_rings = 0;
   const Case plain = run_dress(false, 6000, paper_rule);
@@ -259,37 +260,39 @@ TEST(SurfaceDress, TheFeatureZoneLetsTheFeaturesWinNearThemAndSnapsTheGarmentThr
 // reconstruction stands off the warp. All or nothing, that difference is a step
 // between two neighbouring vertices, a cliff on a fine mesh; eased by the blend's
 // share outside the zone, a slope over about a voxel whatever the mesh.
+// Per edge from a vertex kept exactly at the warp to a neighbour near body B
+// that is not: how far the neighbour stands off the warp per cm of the edge.
+struct KeptEdges {
+  double steepest = 0.0;
+  std::size_t count = 0, steep = 0;  // edges, and those steeper than 0.1
+};
+KeptEdges kept_edges(const Case& c) {
+  KeptEdges e;
+  for (std::size_t f = 0; f < c.dress.faces.rows(); ++f) {
+    const auto face = c.dress.faces.row(f);
+    for (std::size_t k = 0; k < face.size(); ++k) {
+      const Index u = face[k], v = face[(k + 1) % face.size()];
+      if (!(c.body_distance[u] < 1.0 && c.body_distance[v] < 1.0)) continue;
+      const double mu = (c.result.row(u) - c.warped.row(u)).norm(), mv = (c.result.row(v) - c.warped.row(v)).norm();
+      if ((mu == 0.0) == (mv == 0.0)) continue;
+      const double slope = std::max(mu, mv) / (c.dress.positions.row(u) - c.dress.positions.row(v)).norm();
+      ++e.count;
+      e.steep += slope > 0.1;
+      e.steepest = std::max(e.steepest, slope);
+    }
+  }
+  return e;
+}
+
 TEST(SurfaceDress, TheZoneEdgeIsASlopeNotACliffOnAFineMesh) {
   SurfaceOptions eased;
   ASSERT_GT(eased.zone_edge_blend, 0.0);
   eased.near_body_band = 0.0;
+  eased.feature_slide_rings = 0;  // the kept vertices right at the zone (the slide moves them rings away: next test)
   SurfaceOptions cliff = eased;
   cliff.zone_edge_blend = 0.0;
   const Case a = run_dress(false, 60000, cliff), b = run_dress(false, 60000, eased);
-  // Per edge from a vertex kept exactly at the warp to a neighbour near body B
-  // that is not: how far the neighbour stands off the warp per cm of the edge.
-  struct Edge {
-    double steepest = 0.0;
-    std::size_t count = 0, steep = 0;
-  };
-  const auto edge_of_kept = [](const Case& c) {
-    Edge e;
-    for (std::size_t f = 0; f < c.dress.faces.rows(); ++f) {
-      const auto face = c.dress.faces.row(f);
-      for (std::size_t k = 0; k < face.size(); ++k) {
-        const Index u = face[k], v = face[(k + 1) % face.size()];
-        if (!(c.body_distance[u] < 1.0 && c.body_distance[v] < 1.0)) continue;
-        const double mu = (c.result.row(u) - c.warped.row(u)).norm(), mv = (c.result.row(v) - c.warped.row(v)).norm();
-        if ((mu == 0.0) == (mv == 0.0)) continue;
-        const double slope = std::max(mu, mv) / (c.dress.positions.row(u) - c.dress.positions.row(v)).norm();
-        ++e.count;
-        e.steep += slope > 0.1;
-        e.steepest = std::max(e.steepest, slope);
-      }
-    }
-    return e;
-  };
-  const Edge ea = edge_of_kept(a), eb = edge_of_kept(b);
+  const KeptEdges ea = kept_edges(a), eb = kept_edges(b);
   std::printf("  edges from a vertex kept at the warp to one near body B that is not: all or nothing %zu, steepest %.3f "
               "(%zu over 0.1); eased %zu, steepest %.3f (%zu over 0.1); voxel %.2f cm, %zu and %zu vertices kept\n",
               ea.count, ea.steepest, ea.steep, eb.count, eb.steepest, eb.steep, b.stats.voxel, a.stats.vertices_kept,
@@ -298,6 +301,31 @@ TEST(SurfaceDress, TheZoneEdgeIsASlopeNotACliffOnAFineMesh) {
   ASSERT_GT(eb.count, 0u);
   EXPECT_LT(eb.steepest, 0.25 * ea.steepest);
   EXPECT_LT(eb.steep, ea.steep / 4 + 1);
+}
+
+TEST(SurfaceDress, BesideAFeatureTheKeptSurfaceBeginsRingsAway) {
+  // With the eased zone edge alone, the vertices eq. 14 keeps at the warp begin
+  // right beside the zone, which stands off the warp: a slope over a fraction
+  // of a voxel. With feature_slide_rings the agents eq. 14 holds near a feature
+  // keep a share of the solution that fades over those rings, so the kept
+  // vertices begin where the solution has come back to the warp.
+  SurfaceOptions slide;
+  ASSERT_GT(slide.feature_slide_rings, 0);
+  slide.near_body_band = 0.0;
+  SurfaceOptions held = slide;
+  held.feature_slide_rings = 0;
+  const Case a = run_dress(false, 60000, held), b = run_dress(false, 60000, slide);
+  EXPECT_EQ(a.stats.feature_slid, 0u);
+  EXPECT_GT(b.stats.feature_slid, 0u);
+  const KeptEdges ea = kept_edges(a), eb = kept_edges(b);
+  std::printf("  edges from a vertex kept at the warp to one near body B that is not: held %zu, steepest %.3f "
+              "(%zu over 0.1); slide %zu, steepest %.3f (%zu over 0.1); %zu agents slid, voxel %.2f cm\n",
+              ea.count, ea.steepest, ea.steep, eb.count, eb.steepest, eb.steep, b.stats.feature_slid, b.stats.voxel);
+  ASSERT_GT(ea.count, 0u);
+  ASSERT_GT(eb.count, 0u);
+  EXPECT_LT(eb.steepest, 0.5 * ea.steepest);
+  EXPECT_LE(eb.steep, ea.steep);
+  std::printf("  inside body B: held %zu, slide %zu\n", a.inside, b.inside);
 }
 
 TEST(SurfaceDress, TheOuterOfTwoLayersKeepsItsShapeOverTheSlip) {
@@ -311,6 +339,7 @@ TEST(SurfaceDress, TheOuterOfTwoLayersKeepsItsShapeOverTheSlip) {
   // closer still between the profiles: 3.9x and 6.7x against 3.1x and 3.6x.
   SurfaceOptions eq14;
   eq14.near_body_band = 0.0;
+  eq14.feature_slide_rings = 0;
   SurfaceOptions paper = eq14;
   paper.layers = false;
   const Case c = run_dress(false, 12000, {}, false, true);

@@ -227,6 +227,7 @@ int run(ResizeArgs a) {
     options.surface.keep_clear_of_body = false;
     options.surface.feature_zone_rings = 0;  // no zone, no snap
     options.surface.feature_bend_radius = 0.0;
+    options.surface.feature_slide_rings = 0;
     options.surface.near_body_band = 0.0;
     options.surface.layers = false;
     options.surface.follow_body_scale = false;
@@ -423,6 +424,14 @@ const Register resize_command("resize", "Resize a garment from body A to one or 
                  "agent: a cliff one edge wide on a fine mesh)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 0.5))
+      ->group(kAdvanced);
+  app.add_option("--feature-slide", a->surface.feature_slide_rings,
+                 "Within this many one-ring steps of a feature, the agents --epsilon holds at the warp are solved with "
+                 "the rest, kept no farther off body B than the warp, and keep a share of that fading to 0 at this "
+                 "many steps, so the surface beside a feature slopes into the held part (0 = held at the warp, as "
+                 "before; docs/method.md)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 64))
       ->group(kAdvanced);
   app.add_option("--snap-radius", a->surface.snap_radius,
                  "The snap through the features moves the vertices within this many voxels of each feature sample "

@@ -36,6 +36,7 @@ nlohmann::json surface_report(const SurfaceStats& s) {
           {"fixed_feature", s.fixed_feature},
           {"fixed_clearance", s.fixed_clearance},
           {"banded", s.banded},
+          {"feature_slid", s.feature_slid},
           {"fixed_band", s.fixed_band},
           {"feature_bend_agents", s.feature_bend_agents},
           {"feature_bend_rings", s.feature_bend_rings},

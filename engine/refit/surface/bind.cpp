@@ -39,6 +39,7 @@ void check_surface_options(const SurfaceOptions& o) {
   if (o.max_reach_agents == 0 || o.max_reach_agents > 255) throw bad("max reach agents must be 1 to 255");
   if (o.feature_zone_rings < 0 || o.feature_zone_rings > 16) throw bad("feature zone must be 0 to 16 one-ring steps");
   if (!(o.zone_edge_blend >= 0.0 && o.zone_edge_blend <= 0.5)) throw bad("zone edge blend must be 0 to 0.5");
+  if (o.feature_slide_rings < 0 || o.feature_slide_rings > 64) throw bad("feature slide must be 0 to 64 one-ring steps");
   if (!(o.snap_radius >= 0.0) || !std::isfinite(o.snap_radius)) throw bad("snap radius must be 0 or positive");
   if (!(o.snap_remainder_share > 0.0 && o.snap_remainder_share <= 1.0)) throw bad("snap remainder share must be in (0, 1]");
   if (!(o.snap_regularisation > 0.0) || !std::isfinite(o.snap_regularisation))

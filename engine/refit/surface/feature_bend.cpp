@@ -8,8 +8,8 @@ namespace refit {
 namespace {
 constexpr int kFeature = 2, kClearance = 3;
 constexpr Index kKnown = static_cast<Index>(-1);
+}  // namespace
 
-// One-ring steps from the nearest feature agent, up to `rings` (-1: farther).
 std::vector<int> feature_depth(const Csr& ring, const std::vector<std::uint8_t>& fixed, int rings) {
   std::vector<int> depth(fixed.size(), -1);
   std::vector<Index> frontier;
@@ -30,7 +30,6 @@ std::vector<int> feature_depth(const Csr& ring, const std::vector<std::uint8_t>&
   }
   return depth;
 }
-}  // namespace
 
 FeatureBendReport bend_around_features(
     const AgentRows& rows, const Points& h, int rings, const std::vector<std::uint8_t>& free,

@@ -38,6 +38,10 @@ struct FeatureBendReport {
 /// marks them fixed[a] = 3 and returns their count), up to `clearance_rounds` such
 /// agents are held and the zone solved again. Sparse Cholesky of the normal
 /// equations (Eigen); deterministic.
+/// Per agent, the one-ring steps (over `ring`) to the nearest feature agent
+/// (fixed[a] == 2), up to `rings`; -1 farther, or with no feature agent.
+std::vector<int> feature_depth(const Csr& ring, const std::vector<std::uint8_t>& fixed, int rings);
+
 FeatureBendReport bend_around_features(
     const AgentRows& rows, const Points& h, int rings, const std::vector<std::uint8_t>& free,
     std::vector<std::uint8_t>& fixed, Points& x, int clearance_rounds,

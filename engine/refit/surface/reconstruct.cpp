@@ -228,15 +228,25 @@ std::vector<float> SurfaceBinding::keep_near_vertices(const AgentSolution& sol, 
     const double t = std::clamp((outside - (0.5 - blend)) / (2.0 * blend), 0.0, 1.0);
     return t * t * (3.0 - 2.0 * t);
   };
+  // How much of the agents' solution v keeps beside the features (feature_slide_rings): its blend's share of it.
+  const auto slide_share = [&](std::size_t v) {
+    if (sol.slide.empty()) return 0.0;
+    if (blends.weight.empty()) return double(sol.slide[blends.nearest[v]]);
+    double kept = 0.0;
+    for (std::size_t j = blends.reach.offsets[v]; j < blends.reach.offsets[v + 1]; ++j)
+      kept += blends.weight[j] * double(sol.slide[blends.reach.indices[j]]);
+    return std::clamp(kept, 0.0, 1.0);
+  };
   std::vector<float> held(nv, 0.0f);
   parallel_for(0, nv, 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t v = b; v < e; ++v) {
       const Index a = blends.nearest[v];
       if (zone && carries_feature[v]) continue;
-      if (!sol.banded.empty() && sol.banded[a]) continue;
+      const bool slides = !sol.slide.empty() && sol.slide[a] > 0.0f;
+      if (!sol.banded.empty() && sol.banded[a] && !slides) continue;
       const Vec3 p = row3(warped, Index(v));
       if (feature_of_[a] < 0 && body_distance[a] - (p - row3(before, a)).norm() >= options_.epsilon) continue;
-      const double share = warp_share(v);
+      const double share = warp_share(v) * (1.0 - slide_share(v));
       if (!(share > 0.0) || !near_body_b(p)) continue;
       if (share < 1.0)
         positions.row(Eigen::Index(v)) += share * (warped.row(Eigen::Index(v)) - positions.row(Eigen::Index(v)));

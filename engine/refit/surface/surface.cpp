@@ -306,6 +306,28 @@ SurfaceBinding::AgentSolution SurfaceBinding::solve_agents(Points before_in, con
       ceiling[a] = std::max(body_distance[a], options_.clearance) + options_.near_body_band;
     }
   }
+  // Near the features (SurfaceOptions::feature_slide_rings) eq. 14's agents
+  // join the band with a ceiling at their own distance, and a share that fades
+  // with their ring steps from the nearest feature agent.
+  const bool clear = options_.keep_clear_of_body && options_.clearance_rounds > 0;
+  if (options_.feature_slide_rings > 0 && options_.feature_zone_rings > 0 && nf > 0 && clear) {
+    const int rings = options_.feature_slide_rings;
+    const std::vector<int> depth = feature_depth(ring_, fixed, rings);
+    for (std::size_t a = 0; a < n; ++a) {
+      if (!near[a] || depth[a] <= 0) continue;
+      if (banded.empty()) {
+        banded.assign(n, 0);
+        ceiling.assign(n, std::numeric_limits<double>::infinity());
+      }
+      if (sol.slide.empty()) sol.slide.assign(n, 0.0f);
+      const double t = double(rings + 1 - depth[a]) / double(rings);
+      sol.slide[a] = float(t * t * (3.0 - 2.0 * t));
+      banded[a] = 1;
+      near[a] = 0;
+      ceiling[a] = std::max(body_distance[a], options_.clearance);
+      ++st.feature_slid;
+    }
+  }
   for (std::size_t a = 0; a < n; ++a)
     if (near[a]) fixed[a] = 1;
   const bool band = !banded.empty();
@@ -383,7 +405,6 @@ SurfaceBinding::AgentSolution SurfaceBinding::solve_agents(Points before_in, con
   // The first solve only finds which agents sink: it stops at 100 times the
   // tolerance (measured on the 1M dress: 172 fine sweeps in all -> 112). The
   // solves after it go to the tolerance, and agents they sink start another round.
-  const bool clear = options_.keep_clear_of_body && options_.clearance_rounds > 0;
   bool tight = !clear;
   st.iterations = 0;
   solve_fine(tight ? 1.0 : 100.0);
@@ -423,6 +444,9 @@ SurfaceBinding::AgentSolution SurfaceBinding::solve_agents(Points before_in, con
   std::vector<std::uint8_t> anchored_kept(n, 0);
   if (st.anchored > 0) st.anchored_followed = follow_anchored(before, fixed, fr, x, anchored_kept);
   smooth_displacements(before, fr, x);
+  for (std::size_t a = 0; a < sol.slide.size(); ++a)
+    if (sol.slide[a] > 0.0f)
+      x.row(Eigen::Index(a)) = before.row(Eigen::Index(a)) + double(sol.slide[a]) * (x.row(Eigen::Index(a)) - before.row(Eigen::Index(a)));
   st.ms.solve = clock.ms();
   if (n > 0) sol.rotation = rotations(before, x, stretch);
   if (options_.emit_from_original && !options_.encode_on_warped && st.anchored > st.anchored_followed)

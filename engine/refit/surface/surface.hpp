@@ -69,6 +69,15 @@ struct SurfaceOptions {
                                    // the voxel size h; garment units, the pipeline passes cm) the surface is solved again
                                    // in least squares over eq. 13's rows and the feature agents' own, so it leaves a
                                    // held curve with the curve's slope instead of a crease (feature_bend.hpp); 0: off
+  int feature_slide_rings = 6;     // beyond the paper: near a feature, eq. 14 keeps agents no farther from body B
+                                   // instead of in place. The agents it would hold within this many one-ring steps of a
+                                   // feature agent are solved with the rest, held no farther off body B than the warp
+                                   // puts them (the clearance rounds keep them off it), and keep a share of that
+                                   // solution that fades (smoothstep) from the feature to 0 at this many steps; their
+                                   // vertices take the warp by the rest. A feature curve whose optimised shape stands
+                                   // a few mm off the warp beside the body (the dense dress's side profiles at the
+                                   // hips) then slopes into the held surface over these rings instead of one: a raised
+                                   // strip with crumpled edges before. 0: eq. 14 as before; at most 64
   bool snap_to_features = true;    // with a feature zone: correct the vertices near the features so that the written
                                    // garment passes through the optimised curves (see feature_snap.hpp)
   double snap_radius = 2.0;         // the correction reaches the vertices within this many voxels (h) of each feature
@@ -141,6 +150,7 @@ struct SurfaceStats {
   double block_width = 0.0;
   std::size_t fixed_body = 0, fixed_feature = 0;
   std::size_t banded = 0;           // agents eq. 14 would hold that near_body_band frees (on hanging pieces with features)
+  std::size_t feature_slid = 0;     // agents eq. 14 would hold that feature_slide_rings lets follow the features in part
   std::size_t fixed_band = 0;       // ... of which held at their warped distance to body B plus the band
   std::size_t fixed_clearance = 0;  // agents the solve left closer than the clearance to body B, then held at it
   int clearance_rounds = 0;         // re-solves after adding such agents
@@ -282,6 +292,8 @@ class SurfaceBinding {
     std::vector<std::uint8_t> keep;        // agents whose vertices are handed back as warped (empty: none)
     std::vector<double> body_distance;     // per agent: its distance to body B (eq. 14)
     std::vector<std::uint8_t> banded;      // per agent: near body B but solved within the band (empty: none)
+    std::vector<float> slide;              // per agent: the share of its solution kept near a feature (feature_slide_rings;
+                                           // 0: held by eq. 14 or not near body B; empty: none)
     SurfaceStats stats;
   };
   AgentSolution solve_agents(Points before, const Points& feature_targets,
