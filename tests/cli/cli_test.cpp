@@ -255,6 +255,8 @@ TEST(Cli, UsageErrorsExitTwoAndHelpDocumentsExitCodes) {
                                  "resize --garment g.obj --from a.obj --to b.obj --out o.obj --clearance 1e6",
                                  "resize --garment g.obj --from a.obj --to b.obj --out o.obj --snap-remainder 0",
                                  "resize --garment g.obj --from a.obj --to b.obj --out o.obj --snap-remainder 1.5",
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --feature-slide 65",
+                                 "resize --garment g.obj --from a.obj --to b.obj --out o.obj --feature-slide -1",
                                  // Number options take finite values only (CLI11's ranges let NaN through).
                                  "resize --garment g.obj --from a.obj --to b.obj --out o.obj --feature-bend nan",
                                  "resize --garment g.obj --from a.obj --to b.obj --out o.obj --near-body-band nan",
