@@ -28,6 +28,10 @@ struct FeatureBendReport {
   bool solved = false;     // false: nothing to solve, or the factorisation failed (x kept)
 };
 
+/// Per agent, the one-ring steps (over `ring`) to the nearest feature agent
+/// (fixed[a] == 2), up to `rings`; -1 farther, or with no feature agent.
+std::vector<int> feature_depth(const Csr& ring, const std::vector<std::uint8_t>& fixed, int rings);
+
 /// Solves the agents within `rings` one-ring steps of a feature agent (fixed[a]
 /// == 2) again: the unknowns are the zone's agents short of its border that are
 /// free or held by a clearance round (fixed[a] == 3; free[a] or that), the rows
@@ -38,10 +42,6 @@ struct FeatureBendReport {
 /// marks them fixed[a] = 3 and returns their count), up to `clearance_rounds` such
 /// agents are held and the zone solved again. Sparse Cholesky of the normal
 /// equations (Eigen); deterministic.
-/// Per agent, the one-ring steps (over `ring`) to the nearest feature agent
-/// (fixed[a] == 2), up to `rings`; -1 farther, or with no feature agent.
-std::vector<int> feature_depth(const Csr& ring, const std::vector<std::uint8_t>& fixed, int rings);
-
 FeatureBendReport bend_around_features(
     const AgentRows& rows, const Points& h, int rings, const std::vector<std::uint8_t>& free,
     std::vector<std::uint8_t>& fixed, Points& x, int clearance_rounds,

@@ -207,7 +207,9 @@ Points SurfaceBinding::emit_vertices(const AgentSolution& sol, const Points& ori
 // distance cannot rule out are queried: d(v) >= d(a) - |v - a|. Next to the
 // feature zone a vertex takes the warp only by its blend's share outside the
 // zone (SurfaceOptions::zone_edge_blend): the blend weights vary smoothly with
-// the vertex, so the zone's edge is a slope at any mesh resolution.
+// the vertex, so the zone's edge is a slope at any mesh resolution. Beside the
+// features it takes the warp only by its blend's share of what the slid agents
+// do not keep (SurfaceOptions::feature_slide_rings).
 std::vector<float> SurfaceBinding::keep_near_vertices(const AgentSolution& sol, const Points& warped,
                                                       const VertexBlends& blends,
                                                       std::span<const std::uint8_t> carries_feature,
