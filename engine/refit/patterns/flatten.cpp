@@ -345,6 +345,9 @@ class ArapSteps {
 
 Flattening flatten_piece(const Points& xyz, std::span<const Triangle> tris, const FlattenOptions& options,
                          std::span<const HeldEdge> held, const Points2* start_uv) {
+  using Clock = std::chrono::steady_clock;
+  const auto ms_since = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
+  auto start = Clock::now();
   const std::size_t n = static_cast<std::size_t>(xyz.rows());
   if (n < 3 || tris.empty()) throw Error("flatten: a piece needs at least 3 vertices and one triangle");
   for (const Triangle& t : tris)
@@ -353,10 +356,7 @@ Flattening flatten_piece(const Points& xyz, std::span<const Triangle> tris, cons
   const std::vector<std::array<Index, 2>> boundary = boundary_half_edges(tris);
   if (boundary.empty()) throw Error("flatten: the piece is closed (it has no boundary)");
 
-  using Clock = std::chrono::steady_clock;
-  const auto ms_since = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
   Flattening out;
-  auto start = Clock::now();
   Geometry geo = triangle_geometry(xyz, tris);
   const std::array<Index, 2> pin = pins(xyz, boundary);
   for (const HeldEdge& h : held)

@@ -1,12 +1,14 @@
 // Measures of a flattened piece; see measures.hpp.
 #include <refit/patterns/measures.hpp>
 
+#include <refit/core/parallel.hpp>
 #include <refit/patterns/lengths.hpp>
 
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 namespace refit {
@@ -45,40 +47,57 @@ double log_stretch(const std::array<double, 2>& s) {
 
 PieceStretch measure_piece(const Garment& g, const PanelSet& set, std::size_t k, const Points& xyz, const Points2& uv) {
   const Panel& panel = set.panels[k];
-  PieceStretch out;
-  const auto gather = [&](auto rows, Points& p3, Points2& p2) {
-    p3.resize(static_cast<Eigen::Index>(rows.size()), 3);
-    p2.resize(static_cast<Eigen::Index>(rows.size()), 2);
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-      p3.row(static_cast<Eigen::Index>(i)) = xyz.row(rows[i]);
-      p2.row(static_cast<Eigen::Index>(i)) = uv.row(rows[i]);
-    }
-  };
-  Points p3;
-  Points2 p2;
-  out.face.reserve(panel.faces.size());
-  std::size_t t = 0;
-  std::vector<Index> corners;
-  for (Index f : panel.faces) {
-    const Index c0 = g.faces.offsets[f];
-    corners.assign(set.corner_vertex.begin() + c0, set.corner_vertex.begin() + c0 + g.faces.row_size(f));
-    // In the panel's winding: a face the panel turned (panels.cpp) has its fan reversed.
-    if (t < panel.triangles.size() && corners.size() >= 3 && panel.triangles[t][1] != corners[1])
-      std::reverse(corners.begin() + 1, corners.end());
-    gather(corners, p3, p2);
-    const std::array<double, 2> s = face_singular_values(p3, p2);
-    out.face.push_back(log_stretch(s));
-    out.flipped += s[1] < 0;
-    for (; t < panel.triangles.size() && panel.triangle_face[t] == f; ++t) {
-      const Triangle& tri = panel.triangles[t];
-      gather(std::span<const Index>(tri), p3, p2);
-      out.triangle.push_back(log_stretch(face_singular_values(p3, p2)));
-      const Vec3 a = row3(xyz, tri[0]), b = row3(xyz, tri[1]), c = row3(xyz, tri[2]);
-      out.area_3d += 0.5 * (b - a).cross(c - a).norm();
-      const Eigen::Vector2d e = uv.row(tri[1]) - uv.row(tri[0]), h = uv.row(tri[2]) - uv.row(tri[0]);
-      out.area_2d += 0.5 * (e.x() * h.y() - e.y() * h.x());
-    }
+  const std::size_t nf = panel.faces.size(), nt = panel.triangles.size();
+  // Each face's first triangle (the triangles come in face order): the faces are then measured in parallel.
+  std::vector<std::size_t> first(nf + 1, 0);
+  for (std::size_t i = 0, t = 0; i < nf; ++i) {
+    first[i] = t;
+    while (t < nt && panel.triangle_face[t] == panel.faces[i]) ++t;
+    first[i + 1] = t;
   }
+  PieceStretch out;
+  out.face.resize(nf);
+  out.triangle.resize(first[nf]);
+  std::vector<std::uint8_t> flipped(nf, 0);
+  std::vector<double> area_3d(first[nf], 0.0), area_2d(first[nf], 0.0);
+  parallel_for(0, nf, 1024, [&](std::size_t b, std::size_t e) {
+    Points p3;
+    Points2 p2;
+    std::vector<Index> corners;
+    const auto gather = [&](auto rows) {
+      p3.resize(static_cast<Eigen::Index>(rows.size()), 3);
+      p2.resize(static_cast<Eigen::Index>(rows.size()), 2);
+      for (std::size_t i = 0; i < rows.size(); ++i) {
+        p3.row(static_cast<Eigen::Index>(i)) = xyz.row(rows[i]);
+        p2.row(static_cast<Eigen::Index>(i)) = uv.row(rows[i]);
+      }
+    };
+    for (std::size_t i = b; i < e; ++i) {
+      const Index f = panel.faces[i];
+      const Index c0 = g.faces.offsets[f];
+      corners.assign(set.corner_vertex.begin() + c0, set.corner_vertex.begin() + c0 + g.faces.row_size(f));
+      // In the panel's winding: a face the panel turned (panels.cpp) has its fan reversed.
+      const std::size_t t0 = first[i];
+      if (t0 < nt && corners.size() >= 3 && panel.triangles[t0][1] != corners[1])
+        std::reverse(corners.begin() + 1, corners.end());
+      gather(std::span<const Index>(corners));
+      const std::array<double, 2> sv = face_singular_values(p3, p2);
+      out.face[i] = log_stretch(sv);
+      flipped[i] = sv[1] < 0;
+      for (std::size_t t = t0; t < first[i + 1]; ++t) {
+        const Triangle& tri = panel.triangles[t];
+        gather(std::span<const Index>(tri));
+        out.triangle[t] = log_stretch(face_singular_values(p3, p2));
+        const Vec3 a = row3(xyz, tri[0]), bb = row3(xyz, tri[1]), c = row3(xyz, tri[2]);
+        area_3d[t] = 0.5 * (bb - a).cross(c - a).norm();
+        const Eigen::Vector2d u = uv.row(tri[1]) - uv.row(tri[0]), h = uv.row(tri[2]) - uv.row(tri[0]);
+        area_2d[t] = 0.5 * (u.x() * h.y() - u.y() * h.x());
+      }
+    }
+  });
+  // Summed in triangle order whatever the threads.
+  for (std::size_t t = 0; t < first[nf]; ++t) out.area_3d += area_3d[t], out.area_2d += area_2d[t];
+  for (std::uint8_t x : flipped) out.flipped += x;
   for (const auto& loop : panel.loops) {
     out.perimeter_3d += indexed_length(xyz, loop, true);
     out.perimeter_2d += indexed_length(uv, loop, true);

@@ -47,10 +47,13 @@ std::string percent(double x) {
 
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
   const double at = std::clamp(p, 0.0, 100.0) / 100.0 * static_cast<double>(v.size() - 1);
-  const std::size_t lo = static_cast<std::size_t>(std::floor(at)), hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (at - static_cast<double>(lo)) * (v[hi] - v[lo]);
+  const std::size_t lo = static_cast<std::size_t>(std::floor(at));
+  // The lo-th smallest and the next (a sort's v[lo] and v[lo + 1]), in linear time.
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(lo), v.end());
+  const double low = v[lo];
+  const double high = lo + 1 < v.size() ? *std::min_element(v.begin() + static_cast<std::ptrdiff_t>(lo) + 1, v.end()) : low;
+  return low + (at - static_cast<double>(lo)) * (high - low);
 }
 
 PatternCut cut_pattern(const Garment& original, const std::vector<FeatureSpec>& specs, const std::string& file,
