@@ -263,7 +263,10 @@ TEST(Cli, UsageErrorsExitTwoAndHelpDocumentsExitCodes) {
                                  "resize --garment g.obj --from a.obj --to b.obj --out o.obj --zone-edge-blend nan",
                                  "resize --garment g.obj --from a.obj --to b.obj --out o.obj --epsilon inf",
                                  "resize --garment g.obj --from a.obj --to b.obj --out o.obj --snap-radius 1e400",
-                                 "flatten --garment g.obj --out-dir p --dart-target nan"}) {
+                                 "flatten --garment g.obj --out-dir p --dart-target nan",
+                                 "flatten --garment g.obj --out-dir p --seam-tolerance nan",
+                                 "flatten --garment g.obj --out-dir p --seam-tolerance -0.1",
+                                 "flatten --garment g.obj --out-dir p --seam-tolerance 2"}) {
     SCOPED_TRACE(args);
     EXPECT_EQ(run_cli(args).exit_code, 2);
   }

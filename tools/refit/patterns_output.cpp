@@ -47,6 +47,12 @@ void add_pattern_options(CLI::App& app, PatternsOptions& o, const std::string& a
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str()
       ->group(advanced);
+  app.add_option("--seam-tolerance", o.seam_tolerance,
+                 "A piece is flattened again with its seams held only where plain ARAP leaves a seam's two sides "
+                 "more than this fraction of their length apart (0: every piece with a seam)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str()
+      ->group(advanced);
   app.add_option("--conformal-iterations", o.flatten.conformal_iterations,
                  "Conjugate-gradient iterations of the conformal start, at most")
       ->check(CLI::Range(0, 100000))
@@ -75,6 +81,7 @@ PatternWriter::PatternWriter(std::shared_ptr<const Garment> original, const std:
     : garment_(std::move(original)), options_(std::move(options)) {
   pattern_options_.skip_unflattenable = options_.skip_unflattenable;
   pattern_options_.flatten = options_.flatten;
+  pattern_options_.seam_tolerance = options_.seam_tolerance;
   pattern_options_.margin = 2.0 / (100.0 * metres_per_unit(options_.units));  // 2 cm
   cut_ = cut_pattern(*garment_, specs, garment_file, features_file);
   unflattenable_panels(cut_, options_.skip_unflattenable);  // refused before any work

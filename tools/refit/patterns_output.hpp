@@ -26,6 +26,7 @@ struct PatternsOptions {
   std::string darts = "none";  // auto: cut darts where a piece stretches more than dart.max_stretch
   DartOptions dart{0.02, 6};
   FlattenOptions flatten;
+  double seam_tolerance = PatternOptions{}.seam_tolerance;
 };
 
 /// Adds the pattern options shared by `flatten` and `resize --patterns-out`

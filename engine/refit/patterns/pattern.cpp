@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 
@@ -110,26 +111,41 @@ Pattern flatten_pattern(const Garment& g, const PatternCut& cut, const Points& p
         piece.iterations += f.iterations;
         piece.flatten_ms += f.factor_ms + f.conformal_ms + f.arap_ms;
         piece.converged = f.converged;
+        piece.seams_held = held != nullptr;
         piece.flattened = true;
       }
     });
   };
-  // Pass 1, plain ARAP; pass 2 holds each seam's edges, on both sides, at the
-  // length the two sides reached on average in pass 1: sewn edges agree.
+  // Pass 1, plain ARAP. Pass 2 holds the seams' edges where pass 1 left a
+  // seam's two sides more than `seam_tolerance` apart: each panel with such a
+  // seam is flattened again with every seam of it held, a side at the length of
+  // the other side where that panel is not flattened again, else at both sides'
+  // mean. Holding trades stretch for agreement, so a panel whose seams already
+  // agree (a skirt sewn to itself) keeps its plain flattening, and its time.
   flatten_all(nullptr);
-  std::vector<std::vector<HeldEdge>> held(panels.size());
+  const auto side_length = [&](const Seam& s, int side) { return indexed_length(out.pieces[s.panel[side]].uv, s.path[side], false); };
+  const auto both_flattened = [&](const Seam& s) { return out.pieces[s.panel[0]].flattened && out.pieces[s.panel[1]].flattened; };
+  std::vector<std::uint8_t> again(panels.size(), 0);
   if (options.flatten.boundary_weight > 0)
     for (const Seam& s : cut.panels.seams) {
-      if (!out.pieces[s.panel[0]].flattened || !out.pieces[s.panel[1]].flattened) continue;
-      const double l3 = indexed_length(positions, s.garment_path, false);
-      double l2 = 0;
-      for (int side = 0; side < 2; ++side) l2 += 0.5 * indexed_length(out.pieces[s.panel[side]].uv, s.path[side], false);
-      const double f = l3 > 0 ? l2 / l3 : 1.0;
-      for (int side = 0; side < 2; ++side)
-        for (std::size_t i = 0; i + 1 < s.path[side].size(); ++i)
-          held[s.panel[side]].push_back({s.path[side][i], s.path[side][i + 1],
-                                         f * (positions.row(s.garment_path[i]) - positions.row(s.garment_path[i + 1])).norm()});
+      if (!both_flattened(s)) continue;
+      const double l0 = side_length(s, 0), l1 = side_length(s, 1), mean = 0.5 * (l0 + l1);
+      if (options.seam_tolerance <= 0 || std::abs(l0 - l1) > options.seam_tolerance * mean) again[s.panel[0]] = again[s.panel[1]] = 1;
     }
+  std::vector<std::vector<HeldEdge>> held(panels.size());
+  for (const Seam& s : cut.panels.seams) {
+    if (!both_flattened(s) || !(again[s.panel[0]] || again[s.panel[1]])) continue;
+    const double l3 = indexed_length(positions, s.garment_path, false);
+    const double l2 = again[s.panel[0]] && again[s.panel[1]] ? 0.5 * (side_length(s, 0) + side_length(s, 1))
+                                                              : side_length(s, again[s.panel[0]] ? 1 : 0);
+    const double f = l3 > 0 ? l2 / l3 : 1.0;
+    for (int side = 0; side < 2; ++side) {
+      if (!again[s.panel[side]]) continue;
+      for (std::size_t i = 0; i + 1 < s.path[side].size(); ++i)
+        held[s.panel[side]].push_back({s.path[side][i], s.path[side][i + 1],
+                                       f * (positions.row(s.garment_path[i]) - positions.row(s.garment_path[i + 1])).norm()});
+    }
+  }
   flatten_all(&held);
   for (std::size_t k = 0; k < panels.size(); ++k) {
     PatternPiece& piece = out.pieces[k];

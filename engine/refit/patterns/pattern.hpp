@@ -50,6 +50,10 @@ struct PatternOptions {
   double margin = 2.0;           // between pieces on the sheet, in garment units
   Vec3 up = Vec3::UnitY();       // the garment's up: each piece is turned so that it points up the sheet (the grain)
   double stretch_warning = 0.05; // warn when a piece's 95th percentile of |log stretch| exceeds this
+  // A panel is flattened again with its seams held (FlattenOptions::boundary_weight)
+  // only where plain ARAP leaves a seam's two 2D lengths more than this fraction
+  // of their mean apart (0: every panel with a seam). 0.1 %: a millimetre a metre.
+  double seam_tolerance = 0.001;
 };
 
 struct PieceMeasures {
@@ -66,6 +70,7 @@ struct PatternPiece {
   PieceMeasures measures;
   int iterations = 0;
   bool converged = false;
+  bool seams_held = false;           // flattened again with its seams held (PatternOptions::seam_tolerance)
   double flatten_ms = 0;             // wall time of its flattenings (factorisations, conformal start, ARAP)
   double rotation = 0;               // radians the flattened piece was turned by to put its grain up
 };

@@ -37,6 +37,7 @@ nlohmann::json pattern_report(const Garment& g, const PatternCut& cut, const Pat
       j["flipped_faces"] = m.flipped;
       j["iterations"] = piece.iterations;
       j["converged"] = piece.converged;
+      j["seams_held"] = piece.seams_held;
       j["flatten_ms"] = piece.flatten_ms;
       json outlines = json::array();
       for (const auto& loop : p.loops) {
