@@ -99,12 +99,14 @@ double stretch_p95(const Piece& p, const Points2& uv) {
 }
 
 // The --garment mode (see the top).
-void bench_garment(const std::string& file, const std::vector<std::size_t>& threads, int repeat, double seam_tolerance) {
+void bench_garment(const std::string& file, const std::vector<std::size_t>& threads, int repeat, double seam_tolerance,
+                   const FlattenOptions& flatten) {
   const Garment g = read_garment_obj(file);
   const PatternCut cut = cut_pattern(g, {}, file);
   PatternOptions options;
   options.skip_unflattenable = true;
   options.seam_tolerance = seam_tolerance;
+  options.flatten = flatten;
   std::printf("| panel | faces | threads | flatten ms | seams held | iterations | stretch p95 | whole pattern wall ms |\n"
               "|---|---:|---:|---:|---|---:|---:|---:|\n");
   for (std::size_t t : threads) {
@@ -150,12 +152,12 @@ int main(int argc, char** argv) {
       while (i + 1 < argc && argv[i + 1][0] != '-') threads.push_back(std::strtoul(argv[++i], nullptr, 10));
     } else {
       std::fprintf(stderr, "usage: patterns_bench [--repeat N] [--faces N] [--threads T...] [--conformal-iterations N]\n"
-                           "       patterns_bench --garment G.obj [--seam-tolerance X] [--repeat N] [--threads T...]\n");
+                           "       patterns_bench --garment G.obj [--seam-tolerance X] [--repeat N] [--threads T...] [--conformal-iterations N]\n");
       return 2;
     }
   }
   if (!garment.empty()) {
-    bench_garment(garment, threads, repeat, seam_tolerance);
+    bench_garment(garment, threads, repeat, seam_tolerance, options);
     return 0;
   }
   std::printf("| mesh | faces | triangles | threads | wall ms | CPU ms | factor ms | conformal ms (iterations) | "
