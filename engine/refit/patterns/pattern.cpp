@@ -94,7 +94,7 @@ Pattern flatten_pattern(const Garment& g, const PatternCut& cut, const Points& p
   out.warnings = unflattenable_panels(cut, options.skip_unflattenable);
   out.pieces.resize(panels.size());
   std::vector<Points> xyz(panels.size());
-  const auto flatten_all = [&](const std::vector<std::vector<HeldEdge>>* held) {
+  const auto flatten_all = [&](const std::vector<std::vector<HeldEdge>>* held, const FlattenOptions& flatten) {
     parallel_for(0, panels.size(), 1, [&](std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e; ++k) {
         const Panel& panel = panels[k];
@@ -105,8 +105,8 @@ Pattern flatten_pattern(const Garment& g, const PatternCut& cut, const Points& p
           for (std::size_t v = 0; v < panel.vertices.size(); ++v)
             xyz[k].row(static_cast<Eigen::Index>(v)) = positions.row(panel.vertices[v]);
         }
-        const Flattening f = held ? flatten_piece(xyz[k], panel.triangles, options.flatten, (*held)[k], &piece.uv)
-                                  : flatten_piece(xyz[k], panel.triangles, options.flatten);
+        const Flattening f = held ? flatten_piece(xyz[k], panel.triangles, flatten, (*held)[k], &piece.uv)
+                                  : flatten_piece(xyz[k], panel.triangles, flatten);
         piece.uv = f.uv;
         piece.iterations += f.iterations;
         piece.flatten_ms += f.factor_ms + f.conformal_ms + f.arap_ms;
@@ -122,7 +122,7 @@ Pattern flatten_pattern(const Garment& g, const PatternCut& cut, const Points& p
   // the other side where that panel is not flattened again, else at both sides'
   // mean. Holding trades stretch for agreement, so a panel whose seams already
   // agree (a skirt sewn to itself) keeps its plain flattening, and its time.
-  flatten_all(nullptr);
+  flatten_all(nullptr, options.flatten);
   const auto side_length = [&](const Seam& s, int side) { return indexed_length(out.pieces[s.panel[side]].uv, s.path[side], false); };
   const auto both_flattened = [&](const Seam& s) { return out.pieces[s.panel[0]].flattened && out.pieces[s.panel[1]].flattened; };
   std::vector<std::uint8_t> again(panels.size(), 0);
@@ -146,7 +146,20 @@ Pattern flatten_pattern(const Garment& g, const PatternCut& cut, const Points& p
                                        f * (positions.row(s.garment_path[i]) - positions.row(s.garment_path[i + 1])).norm()});
     }
   }
-  flatten_all(&held);
+  flatten_all(&held, options.flatten);
+  // A seam still more than `seam_agreement` apart (a small tab sewn along most
+  // of its outline to a larger piece): its pieces once more, held ten times as hard.
+  std::vector<std::vector<HeldEdge>> harder(panels.size());
+  for (const Seam& s : cut.panels.seams) {
+    if (!both_flattened(s) || !again[s.panel[0]] || !again[s.panel[1]]) continue;
+    const double l0 = side_length(s, 0), l1 = side_length(s, 1);
+    if (!(std::abs(l0 - l1) > options.seam_agreement * 0.5 * (l0 + l1))) continue;
+    for (const Index k : s.panel)
+      if (harder[k].empty()) harder[k] = held[k];
+  }
+  FlattenOptions hard = options.flatten;
+  hard.boundary_weight *= 10;
+  flatten_all(&harder, hard);
   for (std::size_t k = 0; k < panels.size(); ++k) {
     PatternPiece& piece = out.pieces[k];
     if (!piece.flattened) continue;

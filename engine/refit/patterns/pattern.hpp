@@ -54,6 +54,9 @@ struct PatternOptions {
   // only where plain ARAP leaves a seam's two 2D lengths more than this fraction
   // of their mean apart (0: every panel with a seam). 0.1 %: a millimetre a metre.
   double seam_tolerance = 0.001;
+  // A seam whose sides are still more than this fraction apart after that is held
+  // again, ten times as hard, on both its pieces (issue 16: sewn edges within 0.5 %).
+  double seam_agreement = 0.005;
 };
 
 struct PieceMeasures {
