@@ -125,13 +125,16 @@ Pattern flatten_pattern(const Garment& g, const PatternCut& cut, const Points& p
   flatten_all(nullptr, options.flatten);
   const auto side_length = [&](const Seam& s, int side) { return indexed_length(out.pieces[s.panel[side]].uv, s.path[side], false); };
   const auto both_flattened = [&](const Seam& s) { return out.pieces[s.panel[0]].flattened && out.pieces[s.panel[1]].flattened; };
+  // The seam's two sides more than `fraction` of their mean length apart.
+  const auto apart = [&](const Seam& s, double fraction) {
+    const double l0 = side_length(s, 0), l1 = side_length(s, 1);
+    return std::abs(l0 - l1) > fraction * (0.5 * (l0 + l1));
+  };
   std::vector<std::uint8_t> again(panels.size(), 0);
   if (options.flatten.boundary_weight > 0)
-    for (const Seam& s : cut.panels.seams) {
-      if (!both_flattened(s)) continue;
-      const double l0 = side_length(s, 0), l1 = side_length(s, 1), mean = 0.5 * (l0 + l1);
-      if (options.seam_tolerance <= 0 || std::abs(l0 - l1) > options.seam_tolerance * mean) again[s.panel[0]] = again[s.panel[1]] = 1;
-    }
+    for (const Seam& s : cut.panels.seams)
+      if (both_flattened(s) && (options.seam_tolerance <= 0 || apart(s, options.seam_tolerance)))
+        again[s.panel[0]] = again[s.panel[1]] = 1;
   std::vector<std::vector<HeldEdge>> held(panels.size());
   for (const Seam& s : cut.panels.seams) {
     if (!both_flattened(s) || !(again[s.panel[0]] || again[s.panel[1]])) continue;
@@ -151,9 +154,7 @@ Pattern flatten_pattern(const Garment& g, const PatternCut& cut, const Points& p
   // of its outline to a larger piece): its pieces once more, held ten times as hard.
   std::vector<std::vector<HeldEdge>> harder(panels.size());
   for (const Seam& s : cut.panels.seams) {
-    if (!both_flattened(s) || !again[s.panel[0]] || !again[s.panel[1]]) continue;
-    const double l0 = side_length(s, 0), l1 = side_length(s, 1);
-    if (!(std::abs(l0 - l1) > options.seam_agreement * 0.5 * (l0 + l1))) continue;
+    if (!both_flattened(s) || !again[s.panel[0]] || !again[s.panel[1]] || !apart(s, options.seam_agreement)) continue;
     for (const Index k : s.panel)
       if (harder[k].empty()) harder[k] = held[k];
   }
