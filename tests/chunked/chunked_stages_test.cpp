@@ -4,9 +4,11 @@
 #include <refit/chunked/chunked_attach.hpp>
 #include <refit/chunked/chunked_features.hpp>
 #include <refit/chunked/chunked_surface.hpp>
+#include <refit/chunked/chunked_symmetry.hpp>
 #include <refit/chunked/deterministic_sum.hpp>
 #include <refit/core/parallel.hpp>
 #include <refit/core/weld.hpp>
+#include <refit/features/symmetry.hpp>
 #include <refit/io/obj_garment.hpp>
 #include <refit/surface/agents.hpp>
 
@@ -137,6 +139,44 @@ TEST(ChunkedStages, WeldLayersAgentsAttachmentsAndSlicesAreTheInMemoryOnes) {
         EXPECT_TRUE(same_bits(cs.pieces[i].points, ms.pieces[i].points));
       }
       EXPECT_EQ(cs.segments, ms.segments);
+    }
+}
+
+// The mirror images found slab by slab, and where a slab holds more than a
+// tile's elements, column by column across it: within the radius, each is
+// the in-memory locator's, bit for bit.
+TEST(ChunkedStages, MirrorImagesInSlabsAndColumnsAreTheInMemoryOnes) {
+  for (const Garment& garment : garments())
+    for (const std::size_t chunk : {std::size_t(60), std::size_t(100000)}) {
+      const Stored s(garment, chunk, 0);
+      const Garment& g = s.g;
+      SCOPED_TRACE(std::to_string(g.vertex_count()) + " vertices, chunks of " + std::to_string(chunk));
+      const PointGather x(s.store->positions(), s.plan.gather_bytes);
+      // A plane off the middle: the images land at every distance from the surface up to the radius.
+      const double radius = 0.1 * bounding_box_diagonal(g.positions);  // each slab holds its neighbours within it: columns
+      const double c = 0.5 * (g.positions.col(0).minCoeff() + g.positions.col(0).maxCoeff()) + 0.3 * radius;
+      const ChunkedMirror m = chunked_mirror_attach(*s.store, x, s.plan, c, radius);
+      if (chunk < 100000) EXPECT_GT(m.columns, 0u) << "no slab was cut across";
+      else EXPECT_EQ(m.columns, 0u);
+      const SurfaceAttachment at = attach_points(g, mirror_x(g.positions, c));
+      std::vector<MirrorRecord> rec;
+      m.records.read(0, g.vertex_count(), rec);
+      std::size_t within = 0;
+      for (std::size_t v = 0; v < g.vertex_count(); ++v) {
+        const double d = at.offset.row(Eigen::Index(v)).norm();
+        if (!(d <= radius)) {
+          EXPECT_FALSE(rec[v].distance() < d * (1 - 1e-12)) << "vertex " << v << ": an image closer than the locator's";
+          continue;
+        }
+        ++within;
+        ASSERT_EQ(rec[v].vertex, at.vertex[v]) << "vertex " << v;
+        ASSERT_EQ(std::memcmp(rec[v].weight.data(), at.weight[v].data(), sizeof(double) * 3), 0) << "vertex " << v;
+        for (int k = 0; k < 3; ++k)
+          ASSERT_EQ(std::bit_cast<std::uint64_t>(rec[v].offset[std::size_t(k)]),
+                    std::bit_cast<std::uint64_t>(at.offset(Eigen::Index(v), k)))
+              << "vertex " << v;
+      }
+      EXPECT_GT(within, g.vertex_count() / 2);
     }
 }
 

@@ -31,6 +31,7 @@ struct ChunkedMirror {
   RecordFile<MirrorRecord> records;  // per vertex
   double garment_error = 0.0;        // 95th percentile of the distances (check_symmetry's garment error)
   int rounds = 0;
+  std::size_t columns = 0;           // tiles of slabs cut across (a dense slab's elements split to a chunk's size)
 };
 
 /// The mirror images about x = plane_x of all vertices of `g`, exact within `radius`.

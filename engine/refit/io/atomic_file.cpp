@@ -203,15 +203,16 @@ void remove_temporaries_on_signal() {
   }
 }
 
-void write_parts_atomically(const std::string& path, std::size_t count, const PartFormatter& format) {
+void write_parts_atomically(const std::string& path, std::size_t count, const PartFormatter& format,
+                            std::size_t batch) {
   auto temporary = std::make_unique<TemporaryFile>(checked_output_path(path), path);
   const fs::path& tmp = temporary->path();
   int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw input_error(path, std::string("cannot open for writing: ") + std::strerror(errno));
   try {
-    // 64 parts of a few hundred kB: enough work per batch for the threads, and
-    // buffers small enough that reusing them costs no fresh pages.
-    constexpr std::size_t kBatch = 64;
+    // 64 parts of a few hundred kB by default: enough work per batch for the
+    // threads, and buffers small enough that reusing them costs no fresh pages.
+    const std::size_t kBatch = std::max<std::size_t>(batch, 1);
     std::vector<std::string> buffer(std::min(count, kBatch));
     std::vector<off_t> offset(buffer.size() + 1, 0);
     std::atomic<int> error{0};

@@ -79,6 +79,8 @@ using PartFormatter = std::function<void(std::size_t k, std::string& out)>;
 /// buffered stream: the whole text never sits in memory (a 4M-vertex garment is
 /// 364 MB of it). Throws refit::Error naming `path` when the file cannot be
 /// written; an exception from `format` propagates; either way nothing is left.
-void write_parts_atomically(const std::string& path, std::size_t count, const PartFormatter& format);
+/// `batch`: parts formatted at once (their buffers are what the write holds).
+void write_parts_atomically(const std::string& path, std::size_t count, const PartFormatter& format,
+                            std::size_t batch = 64);
 
 }  // namespace refit

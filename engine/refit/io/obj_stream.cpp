@@ -9,6 +9,7 @@
 #include <refit/io/file_bytes.hpp>
 #include <refit/io/obj_detail.hpp>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 
@@ -130,6 +131,8 @@ void ObjStream::write(const std::string& path, const ObjEdits& edits) const {
   const SourceFile src(file_);
   if (src.size() != bytes_) throw input_error(file_, "the file changed while being resized; nothing written");
   const Totals totals{vertices_, texcoords_, normals_};
+  // A group's worth of chunks formatted at once (the chunked mode's budget sets the group).
+  const std::size_t batch = std::clamp<std::size_t>(group_bytes_ / kChunkBytes, 4, 64);
   write_parts_atomically(path, chunk_begin_.size() - 1, [&](std::size_t c, std::string& out) {
     std::string text;
     const std::size_t begin = chunk_begin_[c], size = chunk_begin_[c + 1] - begin;
@@ -175,7 +178,7 @@ void ObjStream::write(const std::string& path, const ObjEdits& edits) const {
     } edit{vspans, nspans, moved, recomputed, x, normals};
     out.reserve(size + size / 4);
     splice_chunk(text, 0, size, 0, nv, 0, nn, edit, out);
-  });
+  }, batch);
 }
 
 }  // namespace refit
