@@ -143,6 +143,17 @@ TEST(Panels, FlatteningAClosedPanelNamesIt) {
   EXPECT_THAT(p.warnings[0], HasSubstr("panel 'box'"));
 }
 
+// A panel of degenerate faces flattens to nothing a cutter can use: said, not silently drawn.
+TEST(Panels, APanelWithNoAreaIsSaid) {
+  const std::string obj = "v 0 0 0\nv 1 0 0\nv 2 0 0\ng line\nf 1 2 3\n"
+                          "g flap\nv 3 0 0\nv 4 0 0\nv 3 1 0\nf 4 5 6\n";
+  const Garment g = parse_garment_obj(obj, "line.obj");
+  const Pattern p = flatten_pattern(g, cut_pattern(g, {}, "line.obj"), g.positions);
+  ASSERT_EQ(p.pieces.size(), 2u);
+  ASSERT_EQ(p.warnings.size(), 1u);
+  EXPECT_THAT(p.warnings[0], HasSubstr("panel 'line' has no area in 3D"));
+}
+
 TEST(Panels, SeamCurvesCutAlongTheNearestEdges) {
   // A 6 x 4 grid cut down the middle by a seam curve at x = 3.1 (between edges).
   const std::string obj = test::grid_obj(6, 4);

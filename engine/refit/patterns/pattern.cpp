@@ -199,6 +199,9 @@ Pattern flatten_pattern(const Garment& g, const PatternCut& cut, const Points& p
     if (piece.measures.flipped > 0)
       out.warnings.push_back("panel '" + panels[k].name + "': " + std::to_string(piece.measures.flipped) +
                              " faces turned over in 2D");
+    if (!(piece.measures.area_3d > 0))
+      out.warnings.push_back("panel '" + panels[k].name + "' has no area in 3D (its faces' corners are collinear or "
+                             "coincident): it is drawn as a line or a point");
   }
   const Packing packing = pack_boxes(boxes, options.margin);
   for (std::size_t k = 0; k < panels.size(); ++k)
