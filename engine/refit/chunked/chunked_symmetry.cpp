@@ -239,7 +239,7 @@ ChunkedMirror chunked_mirror_attach(const GarmentStore& g, const PointGather& x,
         results.push_back(std::move(found));
       };
       const std::size_t slab_element_count = sub.faces.rows() + sub.lines.rows() + sub.points.rows();
-      if (everything || slab_element_count <= 4 * tile_elements || slab_queries.size() < 2) {
+      if (everything || slab_element_count <= 2 * tile_elements || slab_queries.size() < 2) {
         attach_tile(sub, ids, slab_queries);
         continue;
       }
@@ -247,9 +247,10 @@ ChunkedMirror chunked_mirror_attach(const GarmentStore& g, const PointGather& x,
       // radius of it on both sides: the 4M dress's hips, a million faces in a
       // slab planned for 130 thousand) is cut again across, along the second
       // axis: each column takes its queries and the slab's elements within the
-      // radius of them, so a tile's tree stays about a chunk's size. Only above
-      // four chunks' elements: each column repeats the radius's overlap, and
-      // cutting at two took the 1M dress under a 100 MB budget 8 % longer (four: 2 %).
+      // radius of them, so a tile's tree stays about a chunk's size. Above two
+      // chunks' elements: at four the 13M dress under a 1 GB budget peaked at
+      // 1045 MiB (at two 825), and each column repeats the radius's overlap (the
+      // 1M dress under a 100 MB budget 8 % longer).
       const std::size_t columns = std::min(slab_queries.size(), (slab_element_count + tile_elements - 1) / tile_elements);
       std::vector<Query> across = slab_queries;
       std::stable_sort(across.begin(), across.end(),
