@@ -209,11 +209,11 @@ ChunkedMirror chunked_mirror_attach(const GarmentStore& g, const PointGather& x,
       std::sort(slab_queries.begin(), slab_queries.end(), [](const Query& a, const Query& b) { return a.vertex < b.vertex; });
       // The images of `qs` (in vertex order) on the elements of `tile`, whose vertex k is the garment's `tile_ids[k]`.
       const auto attach_tile = [&](const Garment& tile, const std::vector<Index>& tile_ids, std::span<const Query> qs) {
-        auto found = std::make_unique<Spool<Result>>(folder);
         if (tile.faces.rows() + tile.lines.rows() + tile.points.rows() == 0) {
           for (const Query& query : qs) next->push(query);
           return;
         }
+        auto found = std::make_unique<Spool<Result>>(folder);
         Points p(Eigen::Index(qs.size()), 3);
         for (std::size_t k = 0; k < qs.size(); ++k) p.row(Eigen::Index(k)) << qs[k].p[0], qs[k].p[1], qs[k].p[2];
         const SurfaceAttachment at = GarmentLocator(tile).attach(p);

@@ -212,12 +212,12 @@ void write_parts_atomically(const std::string& path, std::size_t count, const Pa
   try {
     // 64 parts of a few hundred kB by default: enough work per batch for the
     // threads, and buffers small enough that reusing them costs no fresh pages.
-    const std::size_t kBatch = std::max<std::size_t>(batch, 1);
-    std::vector<std::string> buffer(std::min(count, kBatch));
+    const std::size_t parts = std::max<std::size_t>(batch, 1);
+    std::vector<std::string> buffer(std::min(count, parts));
     std::vector<off_t> offset(buffer.size() + 1, 0);
     std::atomic<int> error{0};
-    for (std::size_t first = 0; first < count; first += kBatch) {
-      const std::size_t m = std::min(kBatch, count - first);
+    for (std::size_t first = 0; first < count; first += parts) {
+      const std::size_t m = std::min(parts, count - first);
       parallel_for(0, m, 1, [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) {
           buffer[i].clear();
