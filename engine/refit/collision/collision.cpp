@@ -284,6 +284,17 @@ bool face_needs(const Garment& g, const Points& positions, std::size_t f, const 
   return inside;
 }
 
+// How far a vertex known to be outside body B by `outside_by` is still known
+// to be once moved by `move` to `p`: the ball of the rest of that radius about
+// its new place lies in the old ball, so it holds no body point either (a
+// margin for the rounding of the move). A moved vertex keeps most of its
+// bound: the count after the rounds and the next round's faces need fewer
+// queries (the 1M dress: most of the region a round moves is still well clear).
+double outside_after_move(double outside_by, const Vec3& move, const Vec3& p) {
+  const double left = outside_by - move.norm() - 1e-9 * (1.0 + p.cwiseAbs().maxCoeff());
+  return left > 0.0 ? left : 0.0;
+}
+
 bool face_inside(const Garment& g, const Points& positions, std::size_t f, const BodySurface& body,
                  double probe_radius, const std::vector<double>& outside_by) {
   if (g.faces.row_size(f) < 3) return false;
@@ -307,8 +318,8 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   std::vector<Index> touched;   // every vertex any round may have moved
   std::vector<int> ring(n, -1);
   std::vector<long> slot(n, -1);
-  // Per vertex, how far it is known to be outside body B (this round's check, or
-  // an earlier one's for vertices not moved since): see face_needs.
+  // Per vertex, how far it is known to be outside body B (its last check's
+  // distance, less how far it moved since): see face_needs.
   std::vector<double> outside_by(n, 0.0);
   // Per vertex, its closest point on body B within `reach` as of its last check
   // (distance +inf when none): a vertex is checked again whenever it moves, so
@@ -601,7 +612,10 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     parallel_for(0, m, 1024, [&](std::size_t b, std::size_t e) {
       for (std::size_t k = b; k < e; ++k) {
         positions.row(region[k]) += disp[k].transpose();
-        if (disp[k] != Vec3::Zero()) outside_by[region[k]] = 0.0, moved_at[region[k]] = moves_done;  // unknown until checked again
+        if (disp[k] != Vec3::Zero()) {
+          outside_by[region[k]] = outside_after_move(outside_by[region[k]], disp[k], row3(positions, region[k]));
+          moved_at[region[k]] = moves_done;
+        }
       }
     });
     for (Index i : region) ring[i] = -1, slot[i] = -1;
@@ -619,8 +633,8 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     ++moves_done;
     for (const auto& [i, p] : options.after_rounds(positions)) {
       touch(i);
+      outside_by[i] = outside_after_move(outside_by[i], p - row3(positions, i), p);
       positions.row(i) = p.transpose();
-      outside_by[i] = 0.0;
       moved_at[i] = moves_done;
       to_check.push_back(i);
     }
