@@ -3,8 +3,9 @@
 
 For every feature curve and held-out profile of the suite's garments with features, on
 every body of a finished suite run (`run.py --out DIR --methods refit warp`), this finds
-a placement of the curve's *original* shape (a similarity: rotation, translation, scale)
-such that
+a placement of the curve's *original* shape (a similarity: a turn within the curve's plane,
+as the warp turned that plane, a move and a scale; --any-rotation: any turn in 3D, which
+can turn a profile's bulge sideways out of its plane) such that
   - every sample stays within --reach cm of where the warp alone puts it (a curve cannot
     slide around the body: the garment around it goes with it),
   - every sample is at least --clearance cm outside body B,
@@ -17,7 +18,7 @@ search is local, so a miss here proves nothing). Each curve is placed on its own
 curves meet, their placements need not agree. Computed with numpy and scipy from the OBJ
 files, as every score of the suite.
 
-    /usr/bin/python3 bench/quality/reachable.py --dir OUT [--reach 0.5 1 2] [--json R.json]
+    /usr/bin/python3 bench/quality/reachable.py --dir OUT [--reach 0.5 1 2] [--json R.json] [--any-rotation]
 """
 import argparse
 import json
@@ -35,13 +36,44 @@ import run  # noqa: E402
 NEAR_CM = 1.0  # as the suite's near-body change
 
 
-def least_error(x, warped, starts, body_b, near, lo, hi, clearance, reach):
-    """Least shape error of the original samples x placed by a similarity under the constraints
-    (and the placement's parameters: rotation vector, translation, log scale)."""
-    length = np.linalg.norm(np.diff(x, axis=0), axis=1).sum()
+def plane_normal(x):
+    """The normal of the plane that fits the samples x best (their least spread)."""
+    return np.linalg.svd(x - x.mean(0))[2][-1]
+
+
+def placement(x, warped, in_plane):
+    """place(p): the samples x under a similarity with parameters p, and the parameters of the
+    similarity that fits x onto y (for a start). Any similarity: p = rotation vector,
+    translation, log scale. In the plane (in_plane): the fit onto the warp's curve (which turns
+    the curve's plane as the warp does) followed by a turn about that plane's normal, a move
+    and a scale: p = angle, move, log scale; a curve is not turned out of its plane."""
+    if not in_plane:
+        def place(p):
+            return np.exp(p[6]) * x @ Rotation.from_rotvec(p[:3]).as_matrix().T + p[3:6]
+
+        def start(y):
+            r, s, mx, my = meshes.umeyama(x, y)
+            return np.concatenate([Rotation.from_matrix(r).as_rotvec(), my - s * r @ mx, [np.log(s)]])
+        return place, start
+    r0, s0, mx, my = meshes.umeyama(x, warped)
+    n = r0 @ plane_normal(x)
+    base = s0 * (x - mx) @ r0.T  # about the warp's centroid
 
     def place(p):
-        return np.exp(p[6]) * x @ Rotation.from_rotvec(p[:3]).as_matrix().T + p[3:6]
+        return np.exp(p[4]) * base @ Rotation.from_rotvec(p[0] * n).as_matrix().T + my + p[1:4]
+
+    def start(y):
+        r, s, _, my1 = meshes.umeyama(x, y)
+        turn = Rotation.from_matrix(r @ r0.T).as_rotvec()
+        return np.concatenate([[turn @ n], my1 - my, [np.log(s / s0)]])
+    return place, start
+
+
+def least_error(x, warped, starts, body_b, near, lo, hi, clearance, reach, in_plane=True):
+    """Least shape error of the original samples x placed by a similarity under the constraints
+    (and the placement's parameters, see placement())."""
+    length = np.linalg.norm(np.diff(x, axis=0), axis=1).sum()
+    place, start = placement(x, warped, in_plane)
 
     def violation(p):
         z = place(p)
@@ -52,18 +84,16 @@ def least_error(x, warped, starts, body_b, near, lo, hi, clearance, reach):
 
     best = None
     for y in starts:
-        r, s, mx, my = meshes.umeyama(x, y)
-        t = my - s * r @ mx
-        p0 = np.concatenate([Rotation.from_matrix(r).as_rotvec(), t, [np.log(s)]])
-        res = minimize(lambda p: float((violation(p) ** 2).sum()), p0, method="Powell",
+        res = minimize(lambda p: float((violation(p) ** 2).sum()), start(y), method="Powell",
                        options={"xtol": 1e-7, "ftol": 1e-14, "maxfev": 40000})
         if best is None or res.fun < best.fun:
             best = res
     v = violation(best.x)
     # Moving each violating sample by its violation meets the constraints; the curve's
     # shape error is then at most that RMS over its length (scale of the placement undone).
-    error = float(np.sqrt((v ** 2).mean()) / length / np.exp(best.x[6]))
-    return error, float(v.max()), float(np.exp(best.x[6])), best.x
+    scale = float(np.linalg.norm(np.diff(place(best.x), axis=0), axis=1).sum() / length)
+    error = float(np.sqrt((v ** 2).mean()) / length / scale)
+    return error, float(v.max()), scale, best.x
 
 
 def closest_approach(x, y):
@@ -81,7 +111,7 @@ def closest_approach(x, y):
     return best
 
 
-def joint_least(curves, warped, starts, body_b, bands, clearance, reach, gap):
+def joint_least(curves, warped, starts, body_b, bands, clearance, reach, gap, in_plane=True):
     """The feature curves placed together: as least_error, plus every pair of curves that
     meets in the original (closest approach under 0.1 cm) meeting within `gap`."""
     names = list(curves)
@@ -92,8 +122,11 @@ def joint_least(curves, warped, starts, body_b, bands, clearance, reach, gap):
             if d < 0.1:
                 meets.append((names[b], sa, names[a], sb))
 
+    placers = {k: placement(curves[k], warped[k], in_plane)[0] for k in names}
+    size = 5 if in_plane else 7
+
     def place(k, p):
-        return np.exp(p[6]) * curves[k] @ Rotation.from_rotvec(p[:3]).as_matrix().T + p[3:6]
+        return placers[k](p)
 
     def at(z, seg):
         i, t = seg
@@ -102,7 +135,7 @@ def joint_least(curves, warped, starts, body_b, bands, clearance, reach, gap):
     def violation(params):
         z, parts = {}, []
         for n, k in enumerate(names):
-            z[k] = place(k, params[7 * n:7 * n + 7])
+            z[k] = place(k, params[size * n:size * n + size])
             near, lo, hi = bands[k]
             d = body_b.signed_distance(z[k])
             v = np.where(near, np.maximum(0.0, lo - d) + np.maximum(0.0, d - hi), np.maximum(0.0, clearance - d))
@@ -114,7 +147,8 @@ def joint_least(curves, warped, starts, body_b, bands, clearance, reach, gap):
     params = []
     for k in names:  # each curve's own least placement first
         near, lo, hi = bands[k]
-        _, _, _, p = least_error(curves[k], warped[k], [s[k] for s in starts], body_b, near, lo, hi, clearance, reach)
+        _, _, _, p = least_error(curves[k], warped[k], [s[k] for s in starts], body_b, near, lo, hi, clearance, reach,
+                                 in_plane)
         params.append(p)
     res = minimize(lambda p: float(sum((v ** 2).sum() for v in violation(p))), np.concatenate(params),
                    method="Powell", options={"xtol": 1e-7, "ftol": 1e-14, "maxfev": 400000})
@@ -122,7 +156,8 @@ def joint_least(curves, warped, starts, body_b, bands, clearance, reach, gap):
     out = {}
     for n, k in enumerate(names):
         length = np.linalg.norm(np.diff(curves[k], axis=0), axis=1).sum()
-        out[k] = float(np.sqrt((parts[n] ** 2).mean()) / length / np.exp(res.x[7 * n + 6]))
+        scale = np.linalg.norm(np.diff(place(k, res.x[size * n:size * n + size]), axis=0), axis=1).sum() / length
+        out[k] = float(np.sqrt((parts[n] ** 2).mean()) / length / scale)
     return out, [float(v[0]) for v in parts[len(names):]]
 
 
@@ -139,6 +174,9 @@ def main():
     ap.add_argument("--joint", action="store_true",
                     help="also place each case's feature curves together, meeting where they meet (slow: minutes a case)")
     ap.add_argument("--bodies", nargs="+", help="only these target bodies")
+    ap.add_argument("--any-rotation", action="store_true",
+                    help="let a placement turn a curve out of its plane (a front profile's bulge turned sideways "
+                         "meets the band, but is no longer the designer's profile); default: only within it")
     ap.add_argument("--json")
     args = ap.parse_args()
     if not os.path.isdir(args.dir):
@@ -189,7 +227,7 @@ def main():
                     continue
                 for reach in args.reach:
                     e, worst, scale, _ = least_error(x, warped, [warped, refit], body_b, near, lo, hi, args.clearance,
-                                                  reach)
+                                                     reach, not args.any_rotation)
                     row["least"][str(reach)] = dict(error=e, worst_violation=worst, scale=scale)
                 out.append(row)
                 print("| %s | %s | %s | %d/%d | %.5f | %.5f | %.5f%s | %.2f | %s |" % (
@@ -205,7 +243,7 @@ def main():
                                               [{k: v[1] for k, v in feature_case.items()},
                                                {k: v[2] for k, v in feature_case.items()}],
                                               body_b, {k: v[3] for k, v in feature_case.items()}, args.clearance,
-                                              reach, args.gap)
+                                              reach, args.gap, not args.any_rotation)
                     out.append(dict(garment=g, body=body, joint=True, reach=reach, least=least, meeting_misses=gaps))
                     print("| %s | %s | together, reach %g cm | %s; meetings missed by %s cm |" % (
                         g, body, reach, ", ".join("%s %.5f" % kv for kv in least.items()),
