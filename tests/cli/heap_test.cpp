@@ -47,5 +47,25 @@ TEST(Heap, ALargeRunsPeakIsHeldByTheHeapAheadAndReused) {
 #endif
 }
 
+// A 4M garment's heap, grown to its 2.5 GB estimate, was handed back to the
+// system as soon as it was freed (glibc trims a free top above its threshold,
+// and the largest one it takes as a number is INT_MAX bytes), so the run
+// touched its memory twice. Untouched here: no page is faulted in.
+TEST(Heap, AFreedTopAboveTwoGigabytesStaysInTheHeap) {
+#if defined(REFIT_HEAP_REPLACED)
+  GTEST_SKIP() << "the address sanitizer's allocator replaces glibc's heap";
+#else
+  constexpr std::size_t kMb = std::size_t(1) << 20;
+  cli::keep_freed_memory();
+  cli::grow_heap_for_run(0);  // every block from the heap (and nothing grown ahead: too small to be worth it)
+  char* block = static_cast<char*>(std::malloc(2300 * kMb));
+  ASSERT_TRUE(block) << "2.3 GB of address space";
+  const struct mallinfo2 held = mallinfo2();
+  std::free(block);
+  const struct mallinfo2 after = mallinfo2();
+  EXPECT_GE(after.arena, held.arena) << "the heap's free top is kept for the run to reuse";
+#endif
+}
+
 }  // namespace
 }  // namespace refit

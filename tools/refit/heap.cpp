@@ -5,7 +5,6 @@
 #include <malloc.h>
 
 #include <cstdlib>
-#include <limits>
 #include <vector>
 
 namespace refit::cli {
@@ -16,10 +15,13 @@ namespace refit::cli {
 // kernel. Blocks up to 32 MB (glibc's largest threshold: a million rows of 3
 // doubles is 24 MB) now come from the heap, which is not trimmed. Measured on
 // the dense 1M dress (bench/README.md, "Freed memory kept"): minor faults 29k
-// -> 15k, system time 1.9 -> 1.1 s.
+// -> 15k, system time 1.9 -> 1.1 s. Not trimmed at all (-1): the largest
+// threshold (INT_MAX) still trimmed a free top above 2 GB, so a 4M garment's
+// heap grown ahead for the run was handed back at once and touched again
+// (bench/README.md, "A heap above 2 GB was handed back").
 void keep_freed_memory() {
   mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
-  mallopt(M_TRIM_THRESHOLD, std::numeric_limits<int>::max());
+  mallopt(M_TRIM_THRESHOLD, -1);
 }
 
 void grow_heap_for_run(std::size_t peak_bytes) {
