@@ -59,7 +59,7 @@ TEST(Heap, AFreedTopAboveTwoGigabytesStaysInTheHeap) {
   cli::keep_freed_memory();
   cli::grow_heap_for_run(0);  // every block from the heap (and nothing grown ahead: too small to be worth it)
   char* block = static_cast<char*>(std::malloc(2300 * kMb));
-  ASSERT_TRUE(block) << "2.3 GB of address space";
+  if (!block) GTEST_SKIP() << "no 2.3 GB of address space here (ulimit -v, or no overcommit)";
   const struct mallinfo2 held = mallinfo2();
   std::free(block);
   const struct mallinfo2 after = mallinfo2();
