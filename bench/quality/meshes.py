@@ -82,17 +82,23 @@ class Body:
         self.radius = np.linalg.norm(t - self.centres[:, None, :], axis=2).max()
         self.tree = cKDTree(self.centres)
 
+    def closest_candidates(self, p, k=24):
+        """For points p (n, 3): the k triangles with the nearest centres (n, k), the
+        points repeated k times, each triangle's closest point and its distance (n, k)."""
+        _, cand = self.tree.query(p, k=k)
+        n, kk = cand.shape
+        pp = np.repeat(p, kk, axis=0)
+        tri = self.tris[cand.ravel()]
+        q = _closest_on_triangles(pp, self.vertices[tri[:, 0]], self.vertices[tri[:, 1]], self.vertices[tri[:, 2]])
+        return cand, pp, q, np.linalg.norm(pp - q, axis=1).reshape(n, kk)
+
     def signed_distance(self, points, k=24):
         points = np.asarray(points, dtype=float)
         out = np.empty(len(points))
         for s in range(0, len(points), 20000):
             p = points[s:s + 20000]
-            _, cand = self.tree.query(p, k=k)
+            cand, pp, q, d = self.closest_candidates(p, k)
             n, kk = cand.shape
-            pp = np.repeat(p, kk, axis=0)
-            tri = self.tris[cand.ravel()]
-            q = _closest_on_triangles(pp, self.vertices[tri[:, 0]], self.vertices[tri[:, 1]], self.vertices[tri[:, 2]])
-            d = np.linalg.norm(pp - q, axis=1).reshape(n, kk)
             best = d.min(axis=1)
             # Sign: among the candidates as close as the closest, the one whose normal
             # is most aligned with p - q (a closest point on an edge or a vertex).
@@ -378,3 +384,89 @@ def dihedral_change(original, result, faces, pairs=None):
         return np.degrees(np.arccos(cos))
 
     return np.abs(angles(result) - angles(original))
+
+
+def components(positions, faces, ids):
+    """Per vertex: its piece (faces connected through welded vertices `ids`)."""
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import connected_components
+    rows = [ids[f[k]] for f in faces for k in range(len(f))]
+    cols = [ids[f[(k + 1) % len(f)]] for f in faces for k in range(len(f))]
+    n = ids.max() + 1
+    _, label = connected_components(sp.coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n)), directed=False)
+    return label[ids]
+
+
+def _outward(body, p):
+    """Unit directions away from `body` at points p: from the closest body point
+    (inside: towards it), or the closest triangle's normal on the surface."""
+    cand, _, q, d = body.closest_candidates(p)
+    n, kk = cand.shape
+    pick = d.argmin(axis=1)
+    q = q.reshape(n, kk, 3)[np.arange(n), pick]
+    away = p - q
+    length = np.linalg.norm(away, axis=1)
+    sign = np.sign(body.signed_distance(p))
+    sign[sign == 0] = 1.0
+    out = away * (sign / np.maximum(length, 1e-30))[:, None]
+    flat = length < 0.05
+    out[flat] = body.normals[cand[np.arange(n), pick]][flat]
+    return out
+
+
+def _line_hits(o, d, a, b, c):
+    """Where lines o + t d (n, 3) cross triangles (a, b, c) (n, k, 3): t, nan where not."""
+    e1, e2 = b - a, c - a
+    h = np.cross(d[:, None, :], e2)
+    det = np.einsum("nkj,nkj->nk", e1, h)
+    ok = np.abs(det) > 1e-12
+    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+    s = o[:, None, :] - a
+    u = np.einsum("nkj,nkj->nk", s, h) * inv
+    q = np.cross(s, e1)
+    v = np.einsum("nkj,nj->nk", q, d) * inv
+    t = np.einsum("nkj,nkj->nk", q, e2) * inv
+    return np.where(ok & (u >= 0) & (v >= 0) & (u + v <= 1), t, np.nan)
+
+
+def layer_covers(positions, faces, piece, body, reach=3.0, k=48):
+    """Vertices with another piece's surface over them: the line from the body out
+    through the vertex crosses a triangle of another piece within `reach` beyond
+    it (and none of that piece behind it nearer). Returns (vertex, piece) pairs."""
+    tris = fan_triangles(faces)
+    tri_piece = piece[tris[:, 0]]
+    tree = cKDTree(positions[tris].mean(axis=1))
+    d = _outward(body, positions)
+    _, cand = tree.query(positions, k=min(k, len(tris)))
+    t = _line_hits(positions, d, positions[tris[cand, 0]], positions[tris[cand, 1]], positions[tris[cand, 2]])
+    other = tri_piece[cand] != piece[:, None]
+    t = np.where(other & (np.abs(t) < reach), t, np.nan)
+    pairs = []
+    for v in np.nonzero(np.isfinite(t).any(axis=1))[0]:
+        for p in np.unique(tri_piece[cand[v]][np.isfinite(t[v])]):
+            tv = t[v][np.isfinite(t[v]) & (tri_piece[cand[v]] == p)]
+            if tv[np.argmin(np.abs(tv))] > 0.02:
+                pairs.append((int(v), int(p)))
+    return pairs
+
+
+def layers_crossed(positions, faces, piece, body, pairs, k=48):
+    """Of the (vertex, piece) pairs of layer_covers on the input, those whose
+    vertex lies beyond that piece here (the nearest crossing of the line behind
+    it): an inner layer through an outer one. Returns (count, deepest cm)."""
+    if not pairs:
+        return 0, 0.0
+    tris = fan_triangles(faces)
+    tri_piece = piece[tris[:, 0]]
+    v = np.array([p[0] for p in pairs])
+    want = np.array([p[1] for p in pairs])
+    tree = cKDTree(positions[tris].mean(axis=1))
+    d = _outward(body, positions[v])
+    _, cand = tree.query(positions[v], k=min(k, len(tris)))
+    t = _line_hits(positions[v], d, positions[tris[cand, 0]], positions[tris[cand, 1]], positions[tris[cand, 2]])
+    t = np.where((tri_piece[cand] == want[:, None]) & (np.abs(t) < 3.0), t, np.nan)
+    has = np.isfinite(t).any(axis=1)
+    nearest = np.full(len(v), np.nan)
+    nearest[has] = t[has][np.arange(has.sum()), np.nanargmin(np.abs(t[has]), axis=1)]
+    behind = has & (nearest < 0)
+    return int(behind.sum()), float(-nearest[behind].min()) if behind.any() else 0.0

@@ -87,6 +87,8 @@ TARGET_TEXT = {
     "held_out_gain": "profiles between features >= 3x better than the warp",
     "feature_gap": "feature gap <= 0.05 cm",
     "hem_level": "hem height spread <= the warp's",
+    # Beyond issue 13's list (2026-11-30): a garment of several pieces keeps them in order.
+    "layers": "no more vertices through the layer over them than the warp",
 }
 # Face interiors since the collision step probes a coarse face's points over body B's
 # vertices (2026-11-27): 0 in all 22 cases, scored at 21 points per fan triangle; and
@@ -240,6 +242,9 @@ def score(case, original, faces, ids, crease_edges, body_a, body_b, dist_a, sunk
     # The same on edges none of whose faces has a corner on a face the input sinks
     # into body A: such faces must move for their interiors to clear body B.
     s["creases_input_clear"] = int((creased & clear_edges).sum()) if len(creased) else 0
+    # Layers: vertices another piece covered in the input that lie beyond it here.
+    s["layers_crossed"], s["layers_crossed_depth"] = (
+        meshes.layers_crossed(result, faces, case.pieces, body_b, case.covers) if case.covers else (0, 0.0))
     partners = meshes.mirror_partners(original)
     has = partners >= 0
     mirrored = result[has].copy()
@@ -304,6 +309,8 @@ def evaluate(args, case, out_dir):
     body_b = meshes.Body(case.b_path)
     dist_a = body_a.signed_distance(original)
     sunk_a = input_sunk(original, faces, ids, body_a)
+    case.pieces = meshes.components(original, faces, ids)
+    case.covers = meshes.layer_covers(original, faces, case.pieces, body_a) if case.pieces.max() > 0 else []
     face_by_sunk = np.array([bool(sunk_a[list(f)].any()) for f in faces], dtype=bool)
     clear_edges = ~(face_by_sunk[pairs[:, 0]] | face_by_sunk[pairs[:, 1]]) if len(pairs) else np.zeros(0, dtype=bool)
     crease_edges = (welded, pairs, clear_edges)
@@ -355,6 +362,8 @@ def verdicts(rows):
                 v["held_out_gain"] = min(w["held_errors"][k] / max(e, 1e-12) for k, e in s["held_errors"].items()) >= 3
             if "hem_spread" in s:
                 v["hem_level"] = s["hem_spread"] <= w["hem_spread"] + 1e-6
+            if "layers_crossed" in s and "layers_crossed" in w:
+                v["layers"] = s["layers_crossed"] <= w["layers_crossed"]
         if s.get("feature_gap") is not None:
             v["feature_gap"] = s["feature_gap"] <= 0.05
         out[m] = v
@@ -497,6 +506,21 @@ def main():
             above = sum(1 for s, w in got if w is not None and s[key] > w[key]) if m != "warp" else 0
             cells.append("%d / %d | %s" % (max(c), int(np.median(c)), above if m != "warp" else ""))
         print("| %s | %s |" % (m, " | ".join(cells)))
+    print()
+    print("Layers: vertices of one piece that another piece covered in the input (the line out from body A")
+    print("through the vertex crosses it just beyond) and that lie beyond that piece in the result: an inner")
+    print("layer through an outer one. Over the cases of garments of several pieces: the sum, the deepest (cm)")
+    print("and the cases with more than the warp's:")
+    print()
+    print("| method | vertices through | deepest cm | cases above the warp's |")
+    print("|---|---:|---:|---:|")
+    for m in args.methods:
+        got = [(rows[m], rows.get("warp"), case) for case, rows in results if m in rows and case.covers]
+        if not got:
+            continue
+        above = sum(1 for s, w, _ in got if w is not None and s["layers_crossed"] > w["layers_crossed"])
+        print("| %s | %d | %.2f | %s |" % (m, sum(s["layers_crossed"] for s, _, _ in got),
+                                          max(s["layers_crossed_depth"] for s, _, _ in got), above if m != "warp" else ""))
     print()
     print("Targets of issue 13 missed (cases):")
     methods = [m for m in args.methods if any(m in rows for _, rows in results)]
