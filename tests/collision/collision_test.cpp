@@ -408,5 +408,80 @@ TEST(Collision, AGivenVertexAdjacencyGivesTheSameResult) {
   EXPECT_THROW(resolve_penetrations(g, given, body, with), Error);
 }
 
+// Layers: a fine shell too close to the body under a coarse one clear of it.
+// The collision step pushes the inner shell out past the middle of the outer
+// shell's faces; with the layers' order bound on the input, the outer faces
+// go up with it (the shared suit on M_heavier: the trousers through the jacket).
+// The check is a ray from the sphere's centre through each inner vertex, cut
+// with the outer shell's triangles.
+TEST(Collision, AnInnerLayerPushedOffTheBodyStaysUnderTheOuterOne) {
+  const BodyMesh sphere = sphere_body(4, 10.0);
+  const BodySurface body(sphere);
+  const Garment inner = sphere_garment(3, 10.1), outer = sphere_garment(2, 10.28);
+  Garment g;
+  g.positions.resize(inner.positions.rows() + outer.positions.rows(), 3);
+  g.positions << inner.positions, outer.positions;
+  for (std::size_t f = 0; f < inner.faces.rows(); ++f) g.faces.push_row(inner.faces.row(f));
+  const auto first_outer = Index(inner.positions.rows());
+  for (std::size_t f = 0; f < outer.faces.rows(); ++f) {
+    std::array<Index, 3> t;
+    for (int k = 0; k < 3; ++k) t[std::size_t(k)] = outer.faces.row(f)[std::size_t(k)] + first_outer;
+    g.faces.push_row(t);
+  }
+  std::vector<std::uint32_t> layer(g.vertex_count(), 1);
+  std::fill(layer.begin() + first_outer, layer.end(), 2u);
+  const std::vector<LayerCover> covers = bind_layer_order(g, layer, body, 2.0, 0.03);
+  ASSERT_GT(covers.size(), inner.vertex_count() / 2) << "the outer shell covers the inner one";
+  for (const LayerCover& c : covers) {
+    EXPECT_LT(c.inner, first_outer) << "only the inner shell is covered";
+    EXPECT_GT(cover_height(c, g.positions).first, 0.0);
+  }
+  // Where each inner vertex lies under the outer shell: how far out along its
+  // ray the outer shell is, less the vertex's own distance from the centre.
+  const auto below_outer = [&](const Points& x) {
+    double least = std::numeric_limits<double>::infinity();
+    for (Index i = 0; i < first_outer; ++i) {
+      const Vec3 d = row3(x, i).normalized();
+      for (std::size_t f = 0; f < outer.faces.rows(); ++f) {
+        const auto t = outer.faces.row(f);
+        const Vec3 a = row3(x, t[0] + first_outer), e1 = row3(x, t[1] + first_outer) - a, e2 = row3(x, t[2] + first_outer) - a;
+        const Vec3 h = d.cross(e2);
+        const double det = e1.dot(h);
+        if (std::abs(det) < 1e-12) continue;
+        const double u = -a.dot(h) / det;
+        const Vec3 q = (-a).cross(e1);
+        const double v = d.dot(q) / det, along = e2.dot(q) / det;
+        if (u < 0.0 || v < 0.0 || u + v > 1.0 || along <= 0.0) continue;
+        least = std::min(least, along - row3(x, i).norm());
+      }
+    }
+    return least;
+  };
+  ASSERT_GT(below_outer(g.positions), 0.0) << "the input has the outer shell over the inner one";
+
+  Points without = g.positions, with = g.positions;
+  const CollisionReport r_without = resolve_penetrations(g, without, body);
+  ASSERT_LT(below_outer(without), 0.0) << "the fixture must push the inner shell through the outer one";
+  CollisionOptions o;
+  o.layers = &covers;
+  const CollisionReport r = resolve_penetrations(g, with, body, o);
+  EXPECT_EQ(r.layer_covers, covers.size());
+  EXPECT_EQ(r.layers_crossed_before, 0u);  // the step's own pushes cross them
+  EXPECT_EQ(r.layers_crossed_after, 0u);
+  EXPECT_GT(below_outer(with), 0.0);
+  EXPECT_EQ(r.inside_after, 0u);
+  EXPECT_EQ(measure_sanity(g, with).flipped_faces, 0u);
+  // The clearance, but for the step's rounding (an inner vertex taken down to it).
+  for (Index i = 0; i < g.vertex_count(); ++i) EXPECT_GT(body.closest(row3(with, i)).distance, 0.2 - 1e-7);
+  EXPECT_EQ(r_without.layer_covers, 0u);
+  // Threads do not change it.
+  Points one = g.positions;
+  {
+    ThreadLimit limit(1);
+    resolve_penetrations(g, one, body, o);
+  }
+  EXPECT_TRUE(one == with);
+}
+
 }  // namespace
 }  // namespace refit

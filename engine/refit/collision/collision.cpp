@@ -350,6 +350,8 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   };
   std::vector<Vec3> first_position;  // aligned with `touched`: where each started
   std::vector<Index> touched_slot(n, 0);  // a touched vertex's slot in `touched`
+  // Per layer cover: its inner vertex's distance to body B at the step's start.
+  std::vector<double> cover_start(options.layers ? options.layers->size() : 0, std::numeric_limits<double>::infinity());
 
   // The inside test's grid, built in parallel here rather than on the first
   // inside() call of the parallel loop below (there it would run on one thread).
@@ -459,6 +461,57 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
             if (need[i].active) face_found[blk].emplace_back(face[i], need[i]);
         }
     });
+    // Layers: an outer point closer to its inner vertex than it keeps. The inner
+    // vertex goes down as far as it has room above the clearance (the outer
+    // layer is what shows, and the feature curves sit on it); the rest the outer
+    // triangle's corners take, outward, each its least-squares share (as for a
+    // face sample).
+    if (options.layers) {
+      const auto& covers = *options.layers;
+      face_found.emplace_back();
+      std::vector<std::vector<std::pair<Index, Constraint>>> layer_found((covers.size() + kBlock - 1) / kBlock);
+      std::vector<std::size_t> crossed(layer_found.size(), 0);
+      parallel_for(0, layer_found.size(), 1, [&](std::size_t b, std::size_t e) {
+        for (std::size_t blk = b; blk < e; ++blk)
+          for (std::size_t k = blk * kBlock; k < std::min(covers.size(), (blk + 1) * kBlock); ++k) {
+            const LayerCover& c = covers[k];
+            const bool check = all || check_face_of[c.inner] || check_face_of[c.outer[0]] || check_face_of[c.outer[1]] ||
+                               check_face_of[c.outer[2]];
+            if (!check || !finite[c.inner] || !finite[c.outer[0]] || !finite[c.outer[1]] || !finite[c.outer[2]]) continue;
+            if (all) cover_start[k] = near_distance[c.inner];
+            const auto [height, normal] = cover_height(c, positions);
+            const double rounding = 1e-9 * (1.0 + row3(positions, c.inner).cwiseAbs().maxCoeff());
+            if (!(height < c.keep - rounding)) continue;
+            ++crossed[blk];
+            const double short_by = c.keep - height;
+            // It sinks by at most max_lift from where the step found it, as a vertex
+            // near the body rises by at most that beyond its need.
+            const bool inner_pinned = options.pinned && (*options.pinned)[c.inner];
+            const double floor = std::max(options.clearance, cover_start[k] - options.max_lift);
+            const double room = inner_pinned                         ? 0.0
+                                : std::isfinite(near_distance[c.inner]) ? near_distance[c.inner] - floor
+                                                                        : short_by;
+            const double down = std::clamp(room, 0.0, short_by), up = short_by - down;
+            if (down > rounding) layer_found[blk].emplace_back(c.inner, Constraint{-normal, down, true, false});
+            if (!(up > rounding)) continue;
+            // Neither layer moves the corners the feature curves sit on (pinned):
+            // the written garment keeps passing through the curves.
+            std::array<double, 3> w = c.weight;
+            for (int j = 0; j < 3; ++j)
+              if (options.pinned && (*options.pinned)[c.outer[std::size_t(j)]]) w[std::size_t(j)] = 0.0;
+            const double norm2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+            if (!(norm2 > 0.0)) continue;
+            for (int j = 0; j < 3; ++j)
+              if (w[std::size_t(j)] > 0.0)
+                layer_found[blk].emplace_back(c.outer[std::size_t(j)], Constraint{normal, up * w[std::size_t(j)] / norm2, true, false});
+          }
+      });
+      for (auto& list : layer_found) face_found.back().insert(face_found.back().end(), list.begin(), list.end());
+      if (all) {
+        report.layer_covers = covers.size();
+        for (std::size_t k : crossed) report.layers_crossed_before += k;
+      }
+    }
     for (const auto& list : found)
       for (const auto& ic : list) constrained[ic.first] = 0;
     std::size_t vertex_constraints = 0;
@@ -682,15 +735,32 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   // cm in rounds 2 to 5 and was left 0.02 cm through): more rounds over what is
   // still inside, at most options.inside_rounds, each over those vertices and
   // faces' corners only.
+  // The same over the layers still crossed (a constraint the rounds met halfway),
+  // in the first of those rounds.
+  const auto layers_left = [&](std::vector<Index>& check) {
+    if (!options.layers) return;
+    for (const LayerCover& c : *options.layers)
+      if (cover_height(c, positions).first < c.keep - 1e-9 * (1.0 + row3(positions, c.inner).cwiseAbs().maxCoeff()))
+        check.insert(check.end(), {c.inner, c.outer[0], c.outer[1], c.outer[2]});
+    std::sort(check.begin(), check.end());
+    check.erase(std::unique(check.begin(), check.end()), check.end());
+  };
   if (report.rounds > 0)
     for (int extra = 0;; ++extra) {
       to_check = left_inside();
+      // The layers take the first few only: what is inside comes first.
+      constexpr int kLayerRounds = 3;
+      if (extra < kLayerRounds) layers_left(to_check);
       if (to_check.empty() || extra == options.inside_rounds) break;
       report.inside_rounds = extra + 1;
       correction_round(false, true);
     }
   else
     left_inside();
+  if (options.layers)
+    for (const LayerCover& c : *options.layers)
+      report.layers_crossed_after +=
+          cover_height(c, positions).first < c.keep - 1e-6 * (1.0 + row3(positions, c.inner).cwiseAbs().maxCoeff());
   double total = 0.0;
   for (std::size_t k = 0; k < touched.size(); ++k) {
     const double d = (row3(positions, touched[k]) - first_position[k]).norm();
@@ -716,7 +786,10 @@ nlohmann::json CollisionReport::to_json() const {
           {"faces_inside_after", faces_inside_after},
           {"rounds", rounds},
           {"inside_rounds", inside_rounds},
-          {"rechecked", rechecked}};
+          {"rechecked", rechecked},
+          {"layer_covers", layer_covers},
+          {"layers_crossed_before", layers_crossed_before},
+          {"layers_crossed_after", layers_crossed_after}};
 }
 
 }  // namespace refit

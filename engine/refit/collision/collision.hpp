@@ -7,6 +7,7 @@
 // Units: the garment's (CollisionOptions' lengths; the pipeline converts its
 // cm defaults). Threads: parallel inside, the same bits for any thread count.
 #include <refit/body/body_surface.hpp>
+#include <refit/collision/layer_order.hpp>
 #include <refit/core/garment.hpp>
 
 #include <nlohmann/json.hpp>
@@ -59,6 +60,11 @@ struct CollisionOptions {
   /// that resolves one garment on many bodies (on a 1M garment it takes 0.1 s
   /// to make); null: made here.
   const Csr* adjacency = nullptr;
+  /// Optional: where a layer lies over another in the input (bind_layer_order):
+  /// each outer point is kept its `keep` over its inner vertex, its triangle's
+  /// corners pushed outward (spread as any correction) where the inner layer
+  /// came up to it or through it.
+  const std::vector<LayerCover>* layers = nullptr;
 };
 
 struct CollisionReport {
@@ -74,6 +80,9 @@ struct CollisionReport {
   int rounds = 0;
   int inside_rounds = 0;            // of them, rounds over what the others left inside
   std::size_t rechecked = 0;       // vertices checked again by the rounds after the first
+  std::size_t layer_covers = 0;    // vertices with another layer over them (CollisionOptions::layers)
+  std::size_t layers_crossed_before = 0;  // of them, with that layer closer than it keeps (or through them) before
+  std::size_t layers_crossed_after = 0;   // ... and after
 
   nlohmann::json to_json() const;
 };

@@ -21,6 +21,12 @@ namespace refit {
 
 namespace {
 
+// Layers (collision/layer_order.hpp): another layer's surface within this of a
+// vertex and over it is kept over it, by its distance in the input up to the
+// gap (about a fabric's thickness).
+constexpr double kLayerReachCm = 2.0;
+constexpr double kLayerGapCm = 0.03;
+
 // The corners (with a weight) of the faces the feature samples sit on.
 std::vector<std::uint8_t> feature_corners(const SurfaceAttachment& attachment, Eigen::Index vertices) {
   std::vector<std::uint8_t> corner(static_cast<std::size_t>(vertices), 0);
@@ -201,6 +207,13 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
       throw input_error(garment_->source ? garment_->source->file : "garment", e.what());
     }
     bind_report_["surface"] = clock.ms();
+    // Which layer lies over which, for the collision step to keep them so.
+    if (options_.collision && surface_->vertex_layers().size() == garment_->vertex_count()) {
+      clock.reset();
+      layer_covers_ = bind_layer_order(*garment_, surface_->vertex_layers(), BodySurface(body_a_.mesh()),
+                                       kLayerReachCm * per_cm, kLayerGapCm * per_cm);
+      bind_report_["layers"] = clock.ms();
+    }
   }
 }
 
@@ -535,6 +548,7 @@ void GarmentBinding::collision_step(const BodySurface& surface_b, bool symmetric
       return moves;
     };
   co.adjacency = &adjacency;
+  if (!layer_covers_.empty()) co.layers = &layer_covers_;
   const CollisionReport c = resolve_penetrations(*garment_, result.positions, surface_b, co);
   result.report["timings_ms"]["collision"] = clock.ms();
   result.report["collision"] = c.to_json();

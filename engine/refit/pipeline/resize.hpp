@@ -10,6 +10,7 @@
 // parallel inside (core/parallel.hpp), with bit-identical results for any
 // thread count. Bad input: refit::Error, its message naming the file.
 #include <refit/body/body_mesh.hpp>
+#include <refit/collision/layer_order.hpp>
 #include <refit/core/garment.hpp>
 #include <refit/core/progress.hpp>
 #include <refit/features/feature_file.hpp>
@@ -134,6 +135,7 @@ class GarmentBinding {
   std::optional<SurfaceBinding> surface_;
   SurfaceAttachment feature_attachment_;  // where the feature samples (all curves, in order) sit on the garment
   std::vector<double> dip_clearance_;     // per feature sample: dipping_face_clearance (empty: none)
+  std::vector<LayerCover> layer_covers_;  // where a layer lies over another (bind_layer_order; empty: one layer)
   nlohmann::json bind_report_;
   double memory_estimate_mb_ = 0.0;
   // The collision step's vertex adjacency: made by the first resize that needs

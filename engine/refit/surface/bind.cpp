@@ -148,6 +148,7 @@ SurfaceBinding SurfaceBinding::bind(const Garment& g, const Points& features, co
   SurfaceBinding s = bind_agents(std::move(part), features, options, std::move(attachment));
   clock.reset();
   s.blends_ = s.vertex_blends(g.positions, vertex_layer);
+  s.vertex_layer_ = vertex_layer;
   if (s.snaps()) s.snap_reach_ = s.snap_reach(g.positions, vertex_layer);
   s.stats_.vertices_capped = s.blends_.capped;
   s.stats_.vertices_without_agent = s.blends_.without_agent;

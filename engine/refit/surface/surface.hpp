@@ -361,6 +361,8 @@ class SurfaceBinding {
   const SurfaceOptions& options() const { return options_; }
   double voxel() const { return h_; }
   std::size_t agent_count() const { return static_cast<std::size_t>(original_agents_.rows()); }
+  /// Per garment vertex, its layer (garment_layers; empty without layers).
+  const std::vector<std::uint32_t>& vertex_layers() const { return vertex_layer_; }
   std::size_t feature_count() const { return static_cast<std::size_t>(feature_slot_.size()); }
   const Points& original_agents() const { return original_agents_; }
   /// Storage slot of feature sample k.
@@ -420,6 +422,7 @@ class SurfaceBinding {
   BlockSchedule schedule_;
   std::vector<Index> group_;         // connected group of each agent (one-ring graph)
   std::size_t groups_ = 0;
+  std::vector<std::uint32_t> vertex_layer_;  // per garment vertex: its layer (bind; empty without layers or from bind_agents)
   VertexBlends blends_;              // per garment vertex (bind; empty from bind_agents)
   SnapReach snap_reach_;             // per garment vertex with snap_radius > 0 (bind; empty from bind_agents)
   Points original_vertices_;         // emit_from_original: the garment's original positions
