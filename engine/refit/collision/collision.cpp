@@ -496,11 +496,14 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
             if (!(up > rounding)) continue;
             // Neither layer moves the corners the feature curves sit on (pinned):
             // the written garment keeps passing through the curves.
+            // With most of the point's weight on pinned corners the free ones would
+            // have to move many times the shortfall: left crossed (as face_needs leaves
+            // such a face to its pinned corners).
             std::array<double, 3> w = c.weight;
             for (int j = 0; j < 3; ++j)
               if (options.pinned && (*options.pinned)[c.outer[std::size_t(j)]]) w[std::size_t(j)] = 0.0;
+            if (!(w[0] + w[1] + w[2] >= 0.5)) continue;
             const double norm2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
-            if (!(norm2 > 0.0)) continue;
             for (int j = 0; j < 3; ++j)
               if (w[std::size_t(j)] > 0.0)
                 layer_found[blk].emplace_back(c.outer[std::size_t(j)], Constraint{normal, up * w[std::size_t(j)] / norm2, true, false});
