@@ -18,6 +18,13 @@ namespace {
 
 constexpr std::size_t kGrain = 4096;
 
+// A layer cover's outer point lower than it keeps, beyond a rounding margin
+// (`relative` of the coordinates' size).
+constexpr double kCoverRounding = 1e-9;
+bool cover_short(const LayerCover& c, const Points& positions, double relative) {
+  return cover_height(c, positions).first < c.keep - relative * (1.0 + row3(positions, c.inner).cwiseAbs().maxCoeff());
+}
+
 // What a too-close vertex needs: its displacement along unit `dir` must reach `amount`.
 struct Constraint {
   Vec3 dir = Vec3::Zero();
@@ -462,10 +469,9 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
         }
     });
     // Layers: an outer point closer to its inner vertex than it keeps. The inner
-    // vertex goes down as far as it has room above the clearance (the outer
-    // layer is what shows, and the feature curves sit on it); the rest the outer
-    // triangle's corners take, outward, each its least-squares share (as for a
-    // face sample).
+    // vertex goes down by what it may (the outer layer is what shows, and the
+    // feature curves sit on it); the rest the outer triangle's corners take,
+    // outward, each its least-squares share (as for a face sample).
     if (options.layers) {
       const auto& covers = *options.layers;
       face_found.emplace_back();
@@ -480,7 +486,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
             if (!check || !finite[c.inner] || !finite[c.outer[0]] || !finite[c.outer[1]] || !finite[c.outer[2]]) continue;
             if (all) cover_start[k] = near_distance[c.inner];
             const auto [height, normal] = cover_height(c, positions);
-            const double rounding = 1e-9 * (1.0 + row3(positions, c.inner).cwiseAbs().maxCoeff());
+            const double rounding = kCoverRounding * (1.0 + row3(positions, c.inner).cwiseAbs().maxCoeff());
             if (!(height < c.keep - rounding)) continue;
             ++crossed[blk];
             const double short_by = c.keep - height;
@@ -743,8 +749,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   const auto layers_left = [&](std::vector<Index>& check) {
     if (!options.layers) return;
     for (const LayerCover& c : *options.layers)
-      if (cover_height(c, positions).first < c.keep - 1e-9 * (1.0 + row3(positions, c.inner).cwiseAbs().maxCoeff()))
-        check.insert(check.end(), {c.inner, c.outer[0], c.outer[1], c.outer[2]});
+      if (cover_short(c, positions, kCoverRounding)) check.insert(check.end(), {c.inner, c.outer[0], c.outer[1], c.outer[2]});
     std::sort(check.begin(), check.end());
     check.erase(std::unique(check.begin(), check.end()), check.end());
   };
@@ -762,8 +767,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     left_inside();
   if (options.layers)
     for (const LayerCover& c : *options.layers)
-      report.layers_crossed_after +=
-          cover_height(c, positions).first < c.keep - 1e-6 * (1.0 + row3(positions, c.inner).cwiseAbs().maxCoeff());
+      report.layers_crossed_after += cover_short(c, positions, 1e-6);  // counted with a looser rounding margin
   double total = 0.0;
   for (std::size_t k = 0; k < touched.size(); ++k) {
     const double d = (row3(positions, touched[k]) - first_position[k]).norm();

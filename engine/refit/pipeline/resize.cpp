@@ -85,7 +85,7 @@ GarmentBinding::~GarmentBinding() = default;
 // curve there (0.27 cm). The sample keeps its clearance plus how far that
 // corner lies below it on body A (less the margin the curves already keep, at
 // most kDippingFaceCapCm), so the face clears body B where it follows the curve.
-std::vector<double> GarmentBinding::dipping_face_clearance(const Points& samples) const {
+std::vector<double> GarmentBinding::dipping_face_clearance(const BodySurface& surface_a, const Points& samples) const {
   const std::size_t n = feature_attachment_.vertex.size();
   std::vector<double> extra(n, 0.0);
   const double per_cm = units_per_cm(options_.units);
@@ -94,7 +94,6 @@ std::vector<double> GarmentBinding::dipping_face_clearance(const Points& samples
   // Signed by the closest triangle's normal: only points within about a
   // centimetre of body A count here, where that sign is the side they are on
   // (and the inside test's grid, 0.1-0.2 s to build, is not needed).
-  const BodySurface surface_a(body_a_.mesh());
   const double reach = clearance + cap + margin;
   const auto signed_distance = [&](const Vec3& p) {
     const ClosestPoint cp = surface_a.closest_within(p, reach);
@@ -135,6 +134,12 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
   clock.reset();
   // Each garment vertex's mirror image, found on the garment's surface (meshes need not be vertex-symmetric).
   const double plane_x = mirror_plane_x(body_a_.mesh().vertices);
+  // Body A's surface, made once for the dipping faces and the layers.
+  std::optional<BodySurface> body_a_surface;
+  const auto surface_a = [&]() -> const BodySurface& {
+    if (!body_a_surface) body_a_surface.emplace(body_a_.mesh());
+    return *body_a_surface;
+  };
   // The garment's elements in a tree, made once for the mirror images and the feature samples.
   std::optional<GarmentLocator> locator;
   const auto locate = [&]() -> const GarmentLocator& {
@@ -199,7 +204,7 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
       feature_attachment_ = locate().attach(anchors);
       feature_attachment_.offset += all - anchors;
       // With --follow-body the curves follow body B where they sat on body A instead.
-      if (options_.collision && !(options_.follow_body_cm > 0.0)) dip_clearance_ = dipping_face_clearance(all);
+      if (options_.collision && !(options_.follow_body_cm > 0.0)) dip_clearance_ = dipping_face_clearance(surface_a(), all);
     }
     try {
       surface_ = SurfaceBinding::bind(*garment_, all, so, all.rows() > 0 ? &feature_attachment_ : nullptr);
@@ -210,7 +215,7 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
     // Which layer lies over which, for the collision step to keep them so.
     if (options_.collision && surface_->vertex_layers().size() == garment_->vertex_count()) {
       clock.reset();
-      layer_covers_ = bind_layer_order(*garment_, surface_->vertex_layers(), BodySurface(body_a_.mesh()),
+      layer_covers_ = bind_layer_order(*garment_, surface_->vertex_layers(), surface_a(),
                                        kLayerReachCm * per_cm, kLayerGapCm * per_cm);
       bind_report_["layers"] = clock.ms();
     }

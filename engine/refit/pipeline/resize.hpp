@@ -115,7 +115,7 @@ class GarmentBinding {
                                         const Points& before, const Points& after) const;
   /// Per feature sample (all curves in order, at `samples` on the original), the
   /// clearance it keeps beyond the option's where a face under it dips towards body A.
-  std::vector<double> dipping_face_clearance(const Points& samples) const;
+  std::vector<double> dipping_face_clearance(const BodySurface& surface_a, const Points& samples) const;
   Points surface_step(const BodySurface& surface_b, bool symmetric_b, ResizeResult& result,
                       const Progress& progress) const;  // returns the features where the surface step leaves them
   void collision_step(const BodySurface& surface_b, bool symmetric_b, ResizeResult& result,
