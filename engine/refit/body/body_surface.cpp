@@ -2,6 +2,8 @@
 // triangles and ray hits; every distance and every inside/outside decision near
 // the surface is made in double on the body's own positions.
 #include <refit/body/body_surface.hpp>
+
+#include <refit/body/embree_scene.hpp>
 #include <refit/body/centre_tree.hpp>
 #include <refit/core/topology.hpp>
 #include <refit/core/union_find.hpp>
@@ -529,30 +531,13 @@ BodySurface::BodySurface(const BodyMesh& body) : impl_(std::make_unique<Impl>())
     }
   }
 
-  // Embree scene: float copies in Embree-owned (padded) buffers.
   m.device = rtcNewDevice(nullptr);
   if (!m.device) throw Error("Embree: cannot create a device");
   m.scene = rtcNewScene(m.device);
   rtcSetSceneFlags(m.scene, static_cast<RTCSceneFlags>(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION));
   rtcSetSceneBuildQuality(m.scene, RTC_BUILD_QUALITY_MEDIUM);
-  RTCGeometry geom = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_TRIANGLE);
-  auto* vb = static_cast<float*>(
-      rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv));
-  auto* ib = static_cast<unsigned*>(
-      rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nt));
-  if (!vb || !ib) {
-    rtcReleaseGeometry(geom);
-    throw Error("Embree: cannot allocate the body buffers for " + file);
-  }
-  for (Index i = 0; i < nv; ++i)
-    for (int k = 0; k < 3; ++k) vb[3 * i + static_cast<Index>(k)] = static_cast<float>(m.vertices(i, k));
-  for (Index t = 0; t < nt; ++t)
-    for (Index k = 0; k < 3; ++k) ib[3 * t + k] = m.triangles[t][k];
-  rtcCommitGeometry(geom);
-  rtcAttachGeometry(m.scene, geom);
-  rtcReleaseGeometry(geom);
-  rtcCommitScene(m.scene);
-  if (rtcGetDeviceError(m.device) != RTC_ERROR_NONE) throw Error("Embree: building the scene of " + file + " failed");
+  add_triangles(m.device, m.scene, m.vertices, m.triangles, file);
+  commit_scene(m.device, m.scene, file);
 }
 
 Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {

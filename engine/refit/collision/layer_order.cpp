@@ -2,6 +2,7 @@
 #include <refit/collision/layer_order.hpp>
 
 #include <refit/body/embree_ray.hpp>
+#include <refit/body/embree_scene.hpp>
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
 
@@ -95,56 +96,6 @@ Vec3 outward(const BodySurface& body, const Vec3& p) {
   return (away.dot(cp.normal) < 0.0 ? -1.0 : 1.0) * away / len;
 }
 
-// Triangles of a garment in an Embree scene, for rays.
-class RayScene {
- public:
-  RayScene(RTCDevice device, const Points& x, const std::vector<std::array<Index, 3>>& triangles)
-      : scene_(rtcNewScene(device)) {
-    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    // Only the vertices the triangles use (a band of a million-vertex garment).
-    constexpr Index kUnused = std::numeric_limits<Index>::max();
-    std::vector<Index> slot(std::size_t(x.rows()), kUnused), used;
-    for (const auto& t : triangles)
-      for (const Index v : t)
-        if (slot[v] == kUnused) {
-          slot[v] = Index(used.size());
-          used.push_back(v);
-        }
-    auto* vb = static_cast<float*>(
-        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), used.size()));
-    auto* ib = static_cast<unsigned*>(
-        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), triangles.size()));
-    if (!vb || !ib) {
-      rtcReleaseGeometry(geom);
-      rtcReleaseScene(scene_);
-      throw Error("layers: Embree could not allocate the garment's triangles");
-    }
-    for (std::size_t i = 0; i < used.size(); ++i)
-      for (int a = 0; a < 3; ++a) vb[3 * i + std::size_t(a)] = static_cast<float>(x(Eigen::Index(used[i]), a));
-    parallel_for(0, triangles.size(), 4096, [&](std::size_t b, std::size_t e) {
-      for (std::size_t t = b; t < e; ++t)
-        for (int a = 0; a < 3; ++a)
-          ib[3 * t + std::size_t(a)] = slot[triangles[t][std::size_t(a)]];
-    });
-    rtcCommitGeometry(geom);
-    rtcAttachGeometry(scene_, geom);
-    rtcReleaseGeometry(geom);
-    rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_LOW);  // built once, a ray per candidate
-    rtcCommitScene(scene_);
-    if (rtcGetDeviceError(device) != RTC_ERROR_NONE) {
-      rtcReleaseScene(scene_);
-      throw Error("layers: Embree could not build the scene");
-    }
-  }
-  ~RayScene() { rtcReleaseScene(scene_); }
-  RayScene(const RayScene&) = delete;
-  RayScene& operator=(const RayScene&) = delete;
-  RTCScene get() const { return scene_; }
-
- private:
-  RTCScene scene_;
-};
-
 Vec3 triangle_normal(const LayerCover& c, const Points& x) {
   const Vec3 a = row3(x, c.outer[0]), b = row3(x, c.outer[1]), d = row3(x, c.outer[2]);
   const Vec3 m = (b - a).cross(d - a);
@@ -209,7 +160,9 @@ std::vector<LayerCover> bind_layer_order(const Garment& g, const std::vector<std
     std::vector<std::array<Index, 3>> others;
     for (const auto& list : part) others.insert(others.end(), list.begin(), list.end());
     if (others.empty()) continue;
-    const RayScene scene(device.get(), g.positions, others);
+    EmbreeScene scene(device.get(), RTC_BUILD_QUALITY_LOW);  // built once, a ray per candidate
+    scene.add_triangles(g.positions, others, "layers");
+    scene.commit("layers");
     constexpr std::size_t kBlock = 1024;
     std::vector<std::vector<LayerCover>> found((candidates.size() + kBlock - 1) / kBlock);
     parallel_for(0, found.size(), 1, [&](std::size_t b, std::size_t e) {

@@ -1,5 +1,6 @@
 #include <refit/metrics/render.hpp>
 #include <refit/body/embree_ray.hpp>
+#include <refit/body/embree_scene.hpp>
 
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
@@ -23,6 +24,8 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <span>
+#include <vector>
 
 namespace refit {
 
@@ -43,65 +46,34 @@ Camera camera_for(View v) {
   return {Vec3(0, 0, -1), Vec3(1, 0, 0), Vec3(0, 1, 0)};
 }
 
-// One Embree scene: the body (geometry 0) and a garment (geometry 1).
+// One Embree scene: the body (geometry 0) and a garment's fan triangles (geometry 1),
+// those with finite corners.
 class Scene {
  public:
-  Scene(RTCDevice device, const BodyMesh& body, const Garment& garment) : scene_(rtcNewScene(device)) {
-    rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_LOW);  // one picture: build fast, trace little
-    add(device, body.vertices, [&](auto&& emit) {
-      for (const auto& t : body.triangles) emit(t[0], t[1], t[2]);
-    });
-    add(device, garment.positions, [&](auto&& emit) {
-      for (std::size_t f = 0; f < garment.faces.rows(); ++f) {
-        const auto face = garment.faces.row(f);
-        for (std::size_t k = 1; k + 1 < face.size(); ++k) emit(face[0], face[k], face[k + 1]);
+  Scene(RTCDevice device, const BodyMesh& body, const Garment& garment)
+      : scene_(device, RTC_BUILD_QUALITY_LOW) {  // one picture: build fast, trace little
+    const auto finite = [](const Points& p, std::span<const Index> corners) {
+      return std::all_of(corners.begin(), corners.end(), [&](Index i) { return p.row(i).allFinite(); });
+    };
+    std::vector<std::array<Index, 3>> triangles;
+    for (const auto& t : body.triangles)
+      if (finite(body.vertices, t)) triangles.push_back(t);
+    scene_.add_triangles(body.vertices, triangles, "render");
+    triangles.clear();
+    for (std::size_t f = 0; f < garment.faces.rows(); ++f) {
+      const auto face = garment.faces.row(f);
+      for (std::size_t k = 1; k + 1 < face.size(); ++k) {
+        const std::array<Index, 3> t{face[0], face[k], face[k + 1]};
+        if (finite(garment.positions, t)) triangles.push_back(t);
       }
-    });
-    rtcCommitScene(scene_);
-    if (rtcGetDeviceError(device) != RTC_ERROR_NONE) throw Error("render: Embree could not build the scene");
+    }
+    scene_.add_triangles(garment.positions, triangles, "render");
+    scene_.commit("render");
   }
-  ~Scene() { rtcReleaseScene(scene_); }
-  Scene(const Scene&) = delete;
-  Scene& operator=(const Scene&) = delete;
-  RTCScene get() const { return scene_; }
+  RTCScene get() const { return scene_.get(); }
 
  private:
-  template <class Triangles>
-  void add(RTCDevice device, const Points& p, Triangles&& triangles) {
-    std::size_t count = 0;
-    const auto finite = [&](Index i) { return p.row(i).allFinite(); };
-    triangles([&](Index a, Index b, Index c) { count += finite(a) && finite(b) && finite(c); });
-    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    const std::size_t nv = static_cast<std::size_t>(p.rows());
-    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                            3 * sizeof(float), std::max<std::size_t>(nv, 1)));
-    auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                               3 * sizeof(unsigned), count));
-    if (!vb || (count > 0 && !ib)) {
-      rtcReleaseGeometry(geom);
-      throw Error("render: out of memory for the scene");
-    }
-    parallel_for(0, nv, 65536, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i)
-        for (int k = 0; k < 3; ++k) {
-          const double x = p(static_cast<Eigen::Index>(i), k);
-          vb[3 * i + static_cast<std::size_t>(k)] = std::isfinite(x) ? static_cast<float>(x) : 0.0f;
-        }
-    });
-    std::size_t t = 0;
-    triangles([&](Index a, Index b, Index c) {
-      if (!(finite(a) && finite(b) && finite(c))) return;
-      ib[3 * t] = a;
-      ib[3 * t + 1] = b;
-      ib[3 * t + 2] = c;
-      ++t;
-    });
-    rtcCommitGeometry(geom);
-    rtcAttachGeometry(scene_, geom);
-    rtcReleaseGeometry(geom);
-  }
-
-  RTCScene scene_;
+  EmbreeScene scene_;
 };
 
 struct Panel {
