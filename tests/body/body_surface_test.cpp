@@ -387,3 +387,44 @@ TEST(BodySurface, ClearBallsHoldNoBodyPoint) {
 
 }  // namespace
 }  // namespace refit
+
+namespace refit {
+namespace {
+
+// Bodies B share body A's triangles, so a batch makes their topology once
+// (BodyTopology): a surface given another body's answers as one made alone, and
+// a topology of other triangles is not taken.
+TEST(BodySurface, ATopologyServesBodiesOfTheSameTriangles) {
+  const BodyMesh a = test::icosphere(3, 10.0, Vec3(1.0, -2.0, 3.0));
+  BodyMesh b = a;  // another shape, the same triangles
+  for (Eigen::Index v = 0; v < b.vertices.rows(); ++v) {
+    Vec3 p = row3(b.vertices, Index(v));
+    p = Vec3(1.3 * p.x(), p.y() + 0.05 * p.x() * p.x(), 0.8 * p.z());
+    b.vertices.row(v) = p.transpose();
+  }
+  BodyMesh flipped = b;  // one triangle turned over: not oriented, its own topology
+  std::swap(flipped.triangles[5][1], flipped.triangles[5][2]);
+  const BodySurface sa(a);
+  for (const BodyMesh* m : {&b, &flipped}) {
+    const BodySurface own(*m), shared(*m, sa.topology());
+    EXPECT_EQ(shared.topology() == sa.topology(), m == &b);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-16.0, 16.0);
+    for (int i = 0; i < 500; ++i) {
+      const Vec3 p = Vec3(1.0, -2.0, 3.0) + Vec3(u(rng), u(rng), u(rng));
+      const SignedClosestPoint x = own.closest_and_inside(p, 2.0), y = shared.closest_and_inside(p, 2.0);
+      EXPECT_EQ(x.distance, y.distance);
+      EXPECT_EQ(x.inside, y.inside);
+      EXPECT_EQ(own.inside(p), shared.inside(p));
+      EXPECT_EQ(own.signed_distance(p), shared.signed_distance(p));
+      BodySurface::Near n1, n2;
+      own.near(p, 3.0, n1);
+      shared.near(p, 3.0, n2);
+      EXPECT_TRUE(n1.points == n2.points);
+      EXPECT_EQ(n1.edges, n2.edges);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace refit

@@ -173,6 +173,79 @@ bool closer_than_callback(RTCPointQueryFunctionArguments* args) {
 
 }  // namespace
 
+struct BodyTopology {
+  std::vector<std::array<Index, 3>> triangles;  // what it was made from
+  Index vertex_count = 0;
+  // The faces' edges (slot 3t + k: edge k of triangle t) grouped by undirected
+  // edge, each group in slot order: group g is edge_slot[edge_start[g] ..
+  // edge_start[g + 1]).
+  std::vector<Index> edge_slot;
+  std::vector<std::size_t> edge_start;
+  std::vector<std::uint8_t> edge_ok;    // per slot: its edge has exactly two faces with opposite edge directions
+  std::vector<std::uint8_t> vertex_ok;  // every edge around the vertex is ok
+  bool oriented = false;                // closed, manifold, consistently oriented
+  Csr neighbours;                       // per vertex, the other ends of its edges (sorted)
+};
+
+namespace {
+
+std::shared_ptr<const BodyTopology> make_topology(const std::vector<std::array<Index, 3>>& triangles, Index nv) {
+  auto topo = std::make_shared<BodyTopology>();
+  BodyTopology& m = *topo;
+  m.triangles = triangles;
+  m.vertex_count = nv;
+  const Index nt = static_cast<Index>(triangles.size());
+  {
+    Garment surface;  // the body's triangles as faces, for the garments' vertex adjacency
+    surface.positions = Points::Zero(nv, 3);
+    for (const auto& t : triangles) surface.faces.push_row(t);
+    m.neighbours = vertex_adjacency(surface);
+  }
+  // Edge incidence: sort directed edges by undirected key; a good edge has exactly
+  // two faces traversing it in opposite directions.
+  struct DirEdge {
+    std::uint64_t key;
+    Index slot;  // 3t + k
+    bool forward;
+  };
+  std::vector<DirEdge> edges;
+  edges.reserve(3 * static_cast<std::size_t>(nt));
+  for (Index t = 0; t < nt; ++t)
+    for (Index k = 0; k < 3; ++k) {
+      const Index a = triangles[t][k], b = triangles[t][(k + 1) % 3];
+      const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
+      edges.push_back({key, 3 * t + k, a < b});
+    }
+  std::sort(edges.begin(), edges.end(), [](const DirEdge& x, const DirEdge& y) {
+    return x.key < y.key || (x.key == y.key && x.slot < y.slot);
+  });
+  m.edge_slot.resize(edges.size());
+  m.edge_ok.assign(3 * static_cast<std::size_t>(nt), 0);
+  m.vertex_ok.assign(nv, 1);
+  bool all_ok = true;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j].key == edges[i].key) ++j;
+    const bool ok = (j - i == 2) && edges[i].forward != edges[i + 1].forward;
+    m.edge_start.push_back(i);
+    for (std::size_t e = i; e < j; ++e) {
+      m.edge_slot[e] = edges[e].slot;
+      m.edge_ok[edges[e].slot] = ok ? 1 : 0;
+    }
+    if (!ok) {
+      all_ok = false;
+      m.vertex_ok[static_cast<Index>(edges[i].key >> 32)] = 0;
+      m.vertex_ok[static_cast<Index>(edges[i].key & 0xFFFFFFFFu)] = 0;
+    }
+    i = j;
+  }
+  m.edge_start.push_back(edges.size());
+  m.oriented = all_ok;
+  return topo;
+}
+
+}  // namespace
+
 struct BodySurface::Impl {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
@@ -181,10 +254,7 @@ struct BodySurface::Impl {
   Points face_normal;                     // unit, zero for degenerate triangles
   std::vector<std::uint8_t> degenerate;
   Points edge_normal;                     // row 3t+k: sum of the normals of the faces on edge k of t
-  std::vector<std::uint8_t> edge_ok;      // edge has exactly two faces with opposite edge directions
   Points vertex_normal;                   // angle-weighted pseudonormal
-  std::vector<std::uint8_t> vertex_ok;    // every edge around the vertex is ok
-  bool oriented = false;                  // closed, manifold, consistently oriented
   double orientation = 1.0;               // +1 when normals point outward (positive volume)
   double near_tolerance = 0.0;            // below this distance the pseudonormal decides inside
   Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();  // body bounding box
@@ -199,7 +269,7 @@ struct BodySurface::Impl {
   mutable std::array<long, 3> grid_n = {0, 0, 0};
   double tie_tolerance = 0.0;             // hits closer than this along a ray are one crossing
   std::unique_ptr<PointTree> vertex_tree;  // the vertices, for near()
-  Csr neighbours;                          // per vertex, the other ends of its edges (sorted)
+  std::shared_ptr<const BodyTopology> topology;
 
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
@@ -232,17 +302,17 @@ struct BodySurface::Impl {
   // pseudonormal): exact in double for a closed, manifold, oriented mesh.
   // Returns -1 when the feature cannot decide (non-manifold or unoriented).
   int inside_by_pseudonormal(const PointQueryData& d) const {
-    if (!oriented || !std::isfinite(d.best_d2)) return -1;
+    if (!topology->oriented || !std::isfinite(d.best_d2)) return -1;
     Vec3 n;
     if (d.region == kFace) {
       n = row3(face_normal, d.tri);
     } else if (d.region >= kEdge0) {
       const Index e = 3 * d.tri + static_cast<Index>(d.region - kEdge0);
-      if (!edge_ok[e]) return -1;
+      if (!topology->edge_ok[e]) return -1;
       n = row3(edge_normal, e);
     } else {
       const Index v = triangles[d.tri][static_cast<std::size_t>(d.region - kVertex0)];
-      if (!vertex_ok[v]) return -1;
+      if (!topology->vertex_ok[v]) return -1;
       n = row3(vertex_normal, v);
     }
     const double s = (d.p - d.point).dot(n) * orientation;
@@ -281,7 +351,7 @@ struct BodySurface::Impl {
       crossings += side != 0 ? 1 : 0;
       i = j;
     }
-    if (oriented) return winding * static_cast<int>(orientation) > 0 ? 1 : 0;
+    if (topology->oriented) return winding * static_cast<int>(orientation) > 0 ? 1 : 0;
     return crossings & 1;
   }
 
@@ -427,7 +497,8 @@ struct BodySurface::Impl {
   }
 };
 
-BodySurface::BodySurface(const BodyMesh& body) : impl_(std::make_unique<Impl>()) {
+BodySurface::BodySurface(const BodyMesh& body, std::shared_ptr<const BodyTopology> topology)
+    : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   const std::string file = body.path.empty() ? (body.name.empty() ? std::string("<body>") : body.name) : body.path;
   const Index nv = static_cast<Index>(body.vertices.rows());
@@ -442,12 +513,8 @@ BodySurface::BodySurface(const BodyMesh& body) : impl_(std::make_unique<Impl>())
   m.vertices = body.vertices;
   m.triangles = body.triangles;
   m.vertex_tree = std::make_unique<PointTree>(m.vertices);
-  {
-    Garment surface;  // the body's triangles as faces, for the garments' vertex adjacency
-    surface.positions = m.vertices;
-    for (const auto& t : m.triangles) surface.faces.push_row(t);
-    m.neighbours = vertex_adjacency(surface);
-  }
+  const bool same = topology && topology->vertex_count == nv && topology->triangles == m.triangles;
+  m.topology = same ? std::move(topology) : make_topology(m.triangles, nv);
 
   // Face normals, degenerate triangles, bounding box, signed volume.
   m.face_normal.setZero(nt, 3);
@@ -475,46 +542,14 @@ BodySurface::BodySurface(const BodyMesh& body) : impl_(std::make_unique<Impl>())
   m.near_tolerance = 5e-3 * diag;
   m.tie_tolerance = 1e-6 * diag;
 
-  // Edge incidence: sort directed edges by undirected key; a good edge has exactly
-  // two faces traversing it in opposite directions.
-  struct DirEdge {
-    std::uint64_t key;
-    Index slot;  // 3t + k
-    bool forward;
-  };
-  std::vector<DirEdge> edges;
-  edges.reserve(3 * static_cast<std::size_t>(nt));
-  for (Index t = 0; t < nt; ++t)
-    for (Index k = 0; k < 3; ++k) {
-      const Index a = m.triangles[t][k], b = m.triangles[t][(k + 1) % 3];
-      const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
-      edges.push_back({key, 3 * t + k, a < b});
-    }
-  std::sort(edges.begin(), edges.end(), [](const DirEdge& x, const DirEdge& y) {
-    return x.key < y.key || (x.key == y.key && x.slot < y.slot);
-  });
+  // Per edge, the sum of the normals of the faces on it.
   m.edge_normal.setZero(3 * static_cast<Eigen::Index>(nt), 3);
-  m.edge_ok.assign(3 * static_cast<std::size_t>(nt), 0);
-  m.vertex_ok.assign(nv, 1);
-  bool all_ok = true;
-  for (std::size_t i = 0; i < edges.size();) {
-    std::size_t j = i;
-    while (j < edges.size() && edges[j].key == edges[i].key) ++j;
-    const bool ok = (j - i == 2) && edges[i].forward != edges[i + 1].forward;
+  const BodyTopology& topo = *m.topology;
+  for (std::size_t g = 0; g + 1 < topo.edge_start.size(); ++g) {
     Vec3 n = Vec3::Zero();
-    for (std::size_t e = i; e < j; ++e) n += row3(m.face_normal, edges[e].slot / 3);
-    for (std::size_t e = i; e < j; ++e) {
-      m.edge_normal.row(edges[e].slot) = n.transpose();
-      m.edge_ok[edges[e].slot] = ok ? 1 : 0;
-    }
-    if (!ok) {
-      all_ok = false;
-      m.vertex_ok[static_cast<Index>(edges[i].key >> 32)] = 0;
-      m.vertex_ok[static_cast<Index>(edges[i].key & 0xFFFFFFFFu)] = 0;
-    }
-    i = j;
+    for (std::size_t e = topo.edge_start[g]; e < topo.edge_start[g + 1]; ++e) n += row3(m.face_normal, topo.edge_slot[e] / 3);
+    for (std::size_t e = topo.edge_start[g]; e < topo.edge_start[g + 1]; ++e) m.edge_normal.row(topo.edge_slot[e]) = n.transpose();
   }
-  m.oriented = all_ok;
   m.orientation = volume < 0.0 ? -1.0 : 1.0;
 
   // Angle-weighted vertex pseudonormals.
@@ -544,7 +579,16 @@ Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, cons
   return closest_on_triangle(p, a, b, c).point;
 }
 
+std::shared_ptr<const BodyTopology> body_topology(const BodyMesh& body) {
+  const Index nv = static_cast<Index>(body.vertices.rows());
+  for (const auto& t : body.triangles)
+    for (Index c : t)
+      if (c >= nv) throw Error("body topology: a triangle uses vertex " + std::to_string(c + 1) + " of " + std::to_string(nv));
+  return make_topology(body.triangles, nv);
+}
+
 BodySurface::~BodySurface() = default;
+std::shared_ptr<const BodyTopology> BodySurface::topology() const { return impl_->topology; }
 BodySurface::BodySurface(BodySurface&&) noexcept = default;
 BodySurface& BodySurface::operator=(BodySurface&&) noexcept = default;
 
@@ -677,7 +721,7 @@ void BodySurface::near(const Vec3& p, double radius, Near& out) const {
   in.assign(marked.begin(), marked.end());
   std::sort(in.begin(), in.end());
   for (const Index v : in)
-    for (const Index w : m.neighbours.row(v)) {  // once: from its smaller end, or from its only end within
+    for (const Index w : m.topology->neighbours.row(v)) {  // once: from its smaller end, or from its only end within
       if (!(v < w || !(row_of[w] < out.within))) continue;
       if (row_of[w] == kNone) add(w);  // an end outside the radius, once
       out.edges.push_back({row_of[v], row_of[w]});

@@ -28,12 +28,24 @@ struct SignedClosestPoint : ClosestPoint {
 /// Closest point to p on triangle abc (exact, in double).
 Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
 
+/// What a body's surface takes from its triangles alone: which faces share each
+/// edge, which edges and vertices are manifold, each vertex's neighbours. Bodies
+/// B have body A's triangles, so one made for body A serves a whole batch.
+struct BodyTopology;
+/// `body`'s topology (its triangles must use only its vertices: refit::Error otherwise).
+std::shared_ptr<const BodyTopology> body_topology(const BodyMesh& body);
+
 class BodySurface {
  public:
-  explicit BodySurface(const BodyMesh& body);
+  /// `topology`: one made for a body with the same triangles (another body's
+  /// topology() is checked and made anew when they differ); null: made here.
+  explicit BodySurface(const BodyMesh& body, std::shared_ptr<const BodyTopology> topology = nullptr);
   ~BodySurface();
   BodySurface(BodySurface&&) noexcept;
   BodySurface& operator=(BodySurface&&) noexcept;
+
+  /// This body's topology, for the surfaces of other bodies with the same triangles.
+  std::shared_ptr<const BodyTopology> topology() const;
 
   ClosestPoint closest(const Vec3& p) const;
   /// Closest point no farther than max_distance; distance = +inf when none.

@@ -24,6 +24,7 @@ namespace refit {
 
 struct ChunkedBinding::Bound {
   nlohmann::json symmetry_report;
+  std::shared_ptr<const BodyTopology> body_topology;  // body A's triangles: every body B's surface shares them
   std::optional<FeatureBinding> features;
   std::optional<SurfaceBinding> surface;
   SurfaceAttachment feature_attachment;      // where the feature samples (all curves, in order) sit on the garment
@@ -103,6 +104,7 @@ ChunkedBinding::ChunkedBinding(std::shared_ptr<const GarmentStore> garment, Body
   // largest thing a binding holds (4 bytes per vertex and triangle).
   bind_report_["warp"] = clock.ms();
   if (options_.stage == Stage::Warp) return;
+  bound_->body_topology = body_topology(body_a_.mesh());
 
   clock.reset();
   const PointGather x(g.positions(), plan_.gather_bytes);
@@ -219,7 +221,7 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
   if (unchanged) report["unchanged"] = true;
   if (options_.stage != Stage::Warp && !unchanged) {
     clock.reset();
-    const BodySurface surface_b(body_b);
+    const BodySurface surface_b(body_b, bound_->body_topology);
     const auto distance_b = [&](const Vec3& p) { return surface_b.closest(p).distance; };
     // Symmetrise only when body B is symmetric too (the same vertices as body A's, mirrored).
     bool symmetric_b = false;

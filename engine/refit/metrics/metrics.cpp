@@ -223,7 +223,7 @@ ResizeMetrics compute_metrics(const Garment& original, const Points& result, con
 
 ResizeMetrics compute_metrics(const Garment& original, const Points& result, const BodyMesh& a, const BodyMesh& b,
                               const MetricsOptions& options) {
-  const BodySurface sa(a), sb(b);
+  const BodySurface sa(a), sb(b, sa.topology());  // bodies of the same triangles
   return compute_metrics(original, result, sa, sb, options);
 }
 

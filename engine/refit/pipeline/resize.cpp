@@ -131,13 +131,14 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
   bind_report_["warp"] = clock.ms();
 
   if (options_.stage == Stage::Warp) return;
+  body_topology_ = body_topology(body_a_.mesh());
   clock.reset();
   // Each garment vertex's mirror image, found on the garment's surface (meshes need not be vertex-symmetric).
   const double plane_x = mirror_plane_x(body_a_.mesh().vertices);
   // Body A's surface, made once for the dipping faces and the layers.
   std::optional<BodySurface> body_a_surface;
   const auto surface_a = [&]() -> const BodySurface& {
-    if (!body_a_surface) body_a_surface.emplace(body_a_.mesh());
+    if (!body_a_surface) body_a_surface.emplace(body_a_.mesh(), body_topology_);
     return *body_a_surface;
   };
   // The garment's elements in a tree, made once for the mirror images and the feature samples.
@@ -262,7 +263,7 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
   }
 
   const Stopwatch body_clock;  // the feature step's time counts body B's surface
-  const BodySurface surface_b(body_b);
+  const BodySurface surface_b(body_b, body_topology_);
   const bool symmetric_b = body_b_symmetric(body_b, result.report);
   const double body_ms = body_clock.ms();
   const nlohmann::json warp_report = result.report;  // a second pass starts from the warp again
@@ -575,7 +576,7 @@ void GarmentBinding::collision_step(const BodySurface& surface_b, bool symmetric
 void GarmentBinding::metrics_step(const BodySurface& surface_b, ResizeResult& result, const Progress& progress) const {
   const Stopwatch clock;
   progress.stage("measuring");
-  const BodySurface surface_a(body_a_.mesh());
+  const BodySurface surface_a(body_a_.mesh(), body_topology_);
   result.report["metrics"] = {{"warp", compute_metrics(*garment_, result.warped, surface_a, surface_b).to_json()},
                               {"result", compute_metrics(*garment_, result.positions, surface_a, surface_b).to_json()}};
   result.report["timings_ms"]["metrics"] = clock.ms();

@@ -34,6 +34,7 @@
 namespace refit {
 
 class BodySurface;
+struct BodyTopology;
 
 /// How far a resize goes: the warp alone (step 1), warp + feature curves (steps
 /// 1-2: the garment is the warp, the curves are optimised), or all three steps.
@@ -130,6 +131,7 @@ class GarmentBinding {
   GarmentMirror mirror_;               // inactive unless the garment and body A are mirror-symmetric
   std::vector<Index> feature_mirror_;  // per feature sample (all curves, in order): its mirror partner, or kNoMirror
   ReferenceBody body_a_;
+  std::shared_ptr<const BodyTopology> body_topology_;  // body A's triangles: every body B's surface shares them
   WarpBinding warp_;
   std::optional<FeatureBinding> features_;
   std::optional<SurfaceBinding> surface_;
