@@ -1,5 +1,6 @@
 // Step 1 (primary resizing) invariants: identity, rigid motion, uniform scaling,
 // thread-count independence, degenerate triangles.
+#include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
 #include <refit/warp/warp.hpp>
 
@@ -7,6 +8,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstring>
 #include <random>
 
 namespace refit {
@@ -119,6 +121,25 @@ TEST(Warp, SameBitsForOneAndTwoThreads) {
   }
   ASSERT_EQ(one.rows(), two.rows());
   EXPECT_EQ(0, std::memcmp(one.data(), two.data(), sizeof(double) * static_cast<std::size_t>(one.size())));
+}
+
+// The garment, each feature curve and each chunk are warped with one change to
+// body B made once: the same bits as each apply making its own, and a change
+// from another body A is refused.
+TEST(Warp, OneChangeServesEveryPointSet) {
+  const BodyMesh a = sphere(20.0);
+  const BodyMesh b = transformed(a, Eigen::Vector3d(1.1, 0.9, 1.3).asDiagonal(), Vec3(1, 2, 3));
+  const ReferenceBody ref(a), other(a);
+  const TriangleFrames frames_b = compute_frames(b);
+  const TriangleChange change = triangle_change(ref.frames(), frames_b);
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const WarpBinding bind = ref.bind(shell_points(20.0, 500, seed));
+    const Points own = bind.apply(frames_b), shared = bind.apply(change);
+    ASSERT_EQ(own.rows(), shared.rows());
+    EXPECT_EQ(0, std::memcmp(own.data(), shared.data(), sizeof(double) * static_cast<std::size_t>(own.size())));
+  }
+  EXPECT_THROW(other.bind(shell_points(20.0, 10)).apply(change), Error);
+  EXPECT_THROW(triangle_change(ref.frames(), compute_frames(sphere(20.0, 12, 24))), Error);
 }
 
 TEST(Warp, DegenerateTrianglesAreSkippedAndCounted) {

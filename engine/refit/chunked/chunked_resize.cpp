@@ -196,10 +196,11 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
   check_body_b_scale(body_a_.mesh(), body_b, frames_b);
   PointFile warped(plan_.folder, nv);
   std::size_t capped = 0;
+  const TriangleChange change = triangle_change(body_a_.frames(), frames_b);  // once for every chunk
   for_each_chunk(g.positions(), chunk, [&](std::size_t first, const Points& original) {
     const WarpBinding bound = body_a_.bind(original);
     capped += bound.capped;
-    const Points w = bound.apply(frames_b);
+    const Points w = bound.apply(change);
     if (!w.allFinite()) throw Error("internal: the warp produced a non-finite position");
     warped.write(first, w);
   });

@@ -456,9 +456,13 @@ FeatureResult optimise_features(const FeatureBinding& binding, const TriangleFra
                                 const DistanceToBody& distance_to_body_b, const ClearanceToBody& clearance_to_body_b,
                                 std::span<const double> extra_clearance) {
   std::vector<Points> ws, wa;
-  for (std::size_t k = 0; k < binding.model.curves.size(); ++k) {
-    ws.push_back(binding.samples[k].apply(b_frames));
-    wa.push_back(binding.aux[k].apply(b_frames));
+  if (!binding.samples.empty()) {
+    // One change to body B for every curve (each apply would form it for all of body A's triangles).
+    const TriangleChange change = triangle_change(*binding.samples.front().reference, b_frames);
+    for (std::size_t k = 0; k < binding.model.curves.size(); ++k) {
+      ws.push_back(binding.samples[k].apply(change));
+      wa.push_back(binding.aux[k].apply(change));
+    }
   }
   return match_shapes(binding.model, ws, wa, distance_to_body_b, clearance_to_body_b, extra_clearance);
 }

@@ -81,23 +81,19 @@ WarpBinding ReferenceBody::bind(const Points& points) const {
   return b;
 }
 
-Points WarpBinding::apply(const TriangleFrames& b) const {
-  const TriangleFrames& a = *reference;
+TriangleChange triangle_change(const TriangleFrames& a, const TriangleFrames& b) {
   if (b.size() != a.size())
     throw Error("warp: target body has " + std::to_string(b.size()) + " triangles, the binding expects " +
                 std::to_string(a.size()));
   const std::size_t nt = a.size();
-  // Per triangle: M = F_B F_A^T (row-major 3x3), so a point's local coordinates
-  // on A re-emitted on B are c_B + M (p - c_A).
-  std::vector<double> m(9 * nt);
+  TriangleChange c{&a, &b, std::vector<double>(9 * nt), std::vector<std::uint8_t>(nt)};
   // A vertex whose triangles are all where they were on A keeps its position to
   // the bit (A = B gives the garment back, issue 17), not p + (c - c) + R R^T d.
-  std::vector<std::uint8_t> moved(nt);
   parallel_for(0, nt, 4096, [&](std::size_t begin, std::size_t end) {
     for (std::size_t t = begin; t < end; ++t) {
       const Eigen::Index r = static_cast<Eigen::Index>(t);
-      moved[t] = !(a.centre.row(r) == b.centre.row(r) && a.u.row(r) == b.u.row(r) && a.v.row(r) == b.v.row(r) &&
-                   a.w.row(r) == b.w.row(r) && a.valid[t] == b.valid[t]);
+      c.moved[t] = !(a.centre.row(r) == b.centre.row(r) && a.u.row(r) == b.u.row(r) && a.v.row(r) == b.v.row(r) &&
+                     a.w.row(r) == b.w.row(r) && a.valid[t] == b.valid[t]);
       Eigen::Matrix3d fa, fb;
       fa.col(0) = a.u.row(r).transpose();
       fa.col(1) = a.v.row(r).transpose();
@@ -106,9 +102,20 @@ Points WarpBinding::apply(const TriangleFrames& b) const {
       fb.col(1) = b.v.row(r).transpose();
       fb.col(2) = b.w.row(r).transpose();
       const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> mt = fb * fa.transpose();
-      std::copy_n(mt.data(), 9, m.begin() + static_cast<std::ptrdiff_t>(9 * t));
+      std::copy_n(mt.data(), 9, c.m.begin() + static_cast<std::ptrdiff_t>(9 * t));
     }
   });
+  return c;
+}
+
+Points WarpBinding::apply(const TriangleFrames& b) const { return apply(triangle_change(*reference, b)); }
+
+Points WarpBinding::apply(const TriangleChange& change) const {
+  if (change.a != reference.get()) throw Error("internal: a warp applied with another body A's change");
+  const TriangleFrames& a = *change.a;
+  const TriangleFrames& b = *change.b;
+  const std::vector<double>& m = change.m;
+  const std::vector<std::uint8_t>& moved = change.moved;
   const std::size_t n = size();
   Points out(static_cast<Eigen::Index>(n), 3);
   parallel_for(0, n, kGrain, [&](std::size_t begin, std::size_t end) {

@@ -30,6 +30,19 @@ struct WarpOptions {
   std::size_t max_triangles = 32;
 };
 
+/// What every warp to one body B needs per triangle of body A: M = F_B F_A^T (a
+/// point's local coordinates on A re-emitted on B are c_B + M (p - c_A)) and
+/// whether the triangle moved at all. Made once per body B for any number of
+/// WarpBinding::apply calls (the garment, each feature curve, each chunk).
+struct TriangleChange {
+  const TriangleFrames* a = nullptr;  // body A's frames (the bindings' reference)
+  const TriangleFrames* b = nullptr;  // body B's
+  std::vector<double> m;              // 9 per triangle, row-major
+  std::vector<std::uint8_t> moved;
+};
+/// Throws refit::Error when the bodies' triangle counts differ. Keeps pointers to both.
+TriangleChange triangle_change(const TriangleFrames& a, const TriangleFrames& b);
+
 /// What the warp of a fixed point set needs from body A: the points, and per
 /// point its triangle set (CSR, nearest first). Local coordinates are not
 /// stored: frames are orthonormal, so u_i*u' + v_i*v' + w_i*w' = M_i (p - c_i)
@@ -46,6 +59,8 @@ struct WarpBinding {
   /// as A). Triangles degenerate on B are left out of the blend; a point whose
   /// whole set is degenerate on B follows its nearest triangle's centre.
   Points apply(const TriangleFrames& b) const;
+  /// The same with the change to body B made once (its `a` must be this binding's reference).
+  Points apply(const TriangleChange& change) const;
 };
 
 /// Body A prepared for binding: frames and the k-d tree over valid triangle centres.
