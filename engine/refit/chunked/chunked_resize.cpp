@@ -238,7 +238,7 @@ ChunkedResult ChunkedBinding::resize(const BodyMesh& body_b, const std::string& 
     FeatureResult& curves = result.features;
     if (bound_->features) {
       progress.stage("optimising " + std::to_string(bound_->features->model.curves.size()) + " feature curves");
-      curves = optimise_features(*bound_->features, frames_b, distance_b);
+      curves = optimise_features(*bound_->features, change, distance_b);
       if (symmetric_b && !bound_->feature_mirror.empty()) {
         symmetrise_curves(curves, bound_->feature_mirror, bound_->mirror_x);
         restore_meetings(bound_->features->model, curves);

@@ -455,14 +455,19 @@ FeatureBinding bind_features(const ReferenceBody& a, std::vector<FeatureCurve> c
 FeatureResult optimise_features(const FeatureBinding& binding, const TriangleFrames& b_frames,
                                 const DistanceToBody& distance_to_body_b, const ClearanceToBody& clearance_to_body_b,
                                 std::span<const double> extra_clearance) {
+  if (binding.samples.empty()) return optimise_features(binding, TriangleChange{}, distance_to_body_b, clearance_to_body_b, extra_clearance);
+  return optimise_features(binding, triangle_change(*binding.samples.front().reference, b_frames), distance_to_body_b,
+                           clearance_to_body_b, extra_clearance);
+}
+
+// One change to body B for every curve (each apply would form it for all of body A's triangles).
+FeatureResult optimise_features(const FeatureBinding& binding, const TriangleChange& change_b,
+                                const DistanceToBody& distance_to_body_b, const ClearanceToBody& clearance_to_body_b,
+                                std::span<const double> extra_clearance) {
   std::vector<Points> ws, wa;
-  if (!binding.samples.empty()) {
-    // One change to body B for every curve (each apply would form it for all of body A's triangles).
-    const TriangleChange change = triangle_change(*binding.samples.front().reference, b_frames);
-    for (std::size_t k = 0; k < binding.model.curves.size(); ++k) {
-      ws.push_back(binding.samples[k].apply(change));
-      wa.push_back(binding.aux[k].apply(change));
-    }
+  for (std::size_t k = 0; k < binding.model.curves.size(); ++k) {
+    ws.push_back(binding.samples[k].apply(change_b));
+    wa.push_back(binding.aux[k].apply(change_b));
   }
   return match_shapes(binding.model, ws, wa, distance_to_body_b, clearance_to_body_b, extra_clearance);
 }

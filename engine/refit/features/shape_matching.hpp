@@ -246,5 +246,9 @@ FeatureBinding bind_features(const ReferenceBody& a, std::vector<FeatureCurve> c
 FeatureResult optimise_features(const FeatureBinding& binding, const TriangleFrames& b_frames,
                                 const DistanceToBody& distance_to_body_b, const ClearanceToBody& clearance_to_body_b = {},
                                 std::span<const double> extra_clearance = {});
+/// The same with the change to body B made once for the garment's warp too (triangle_change).
+FeatureResult optimise_features(const FeatureBinding& binding, const TriangleChange& change_b,
+                                const DistanceToBody& distance_to_body_b, const ClearanceToBody& clearance_to_body_b = {},
+                                std::span<const double> extra_clearance = {});
 
 }  // namespace refit

@@ -251,7 +251,8 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
   result.report["memory_estimate_mb"] = memory_estimate_mb_;
 
   // Step 1: primary resizing (section 3).
-  const TriangleFrames frames_b = warp_step(body_b, result, progress);
+  const TriangleFrames frames_b = compute_frames(body_b);
+  const TriangleChange change_b = warp_step(body_b, frames_b, result, progress);
   if (options_.stage == Stage::Warp) return result;
   // Body B is body A wherever the garment is bound, so the warp kept every vertex
   // to the bit: the garment as given is the answer. The later steps only correct
@@ -268,7 +269,7 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
   const double body_ms = body_clock.ms();
   const nlohmann::json warp_report = result.report;  // a second pass starts from the warp again
   const std::vector<std::string> warp_warnings = result.warnings;
-  Points feature_before_collision = shape_steps(frames_b, surface_b, symmetric_b, {}, result, progress);
+  Points feature_before_collision = shape_steps(change_b, surface_b, symmetric_b, {}, result, progress);
   if (surface_ && !result.features.curves.empty()) {
     Points written = carry(feature_attachment_, result.positions);
     // Where the collision step pushed a curve's faces off a bulge of body B
@@ -282,7 +283,7 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
     if (!lift.empty()) {
       const Stopwatch again_clock;
       ResizeResult again{result.warped, result.warped, {}, warp_report, warp_warnings};
-      Points again_before = shape_steps(frames_b, surface_b, symmetric_b, lift, again, progress);
+      Points again_before = shape_steps(change_b, surface_b, symmetric_b, lift, again, progress);
       Points again_written = carry(feature_attachment_, again.positions);
       if (closer_to_curves(carried_curve_gaps(result.features, written),
                            carried_curve_gaps(again.features, again_written),
@@ -303,11 +304,11 @@ ResizeResult GarmentBinding::resize(const BodyMesh& body_b, const Progress& prog
   return result;
 }
 
-Points GarmentBinding::shape_steps(const TriangleFrames& frames_b, const BodySurface& surface_b, bool symmetric_b,
+Points GarmentBinding::shape_steps(const TriangleChange& change_b, const BodySurface& surface_b, bool symmetric_b,
                                    const std::vector<double>& lift, ResizeResult& result,
                                    const Progress& progress) const {
   // Step 2: feature curves keep their shape (section 4).
-  if (features_) feature_step(frames_b, surface_b, symmetric_b, lift, result, progress);
+  if (features_) feature_step(change_b, surface_b, symmetric_b, lift, result, progress);
   // Step 3: the surface follows the curves and keeps its local shape (section 5).
   Points feature_before_collision;
   if (surface_) feature_before_collision = surface_step(surface_b, symmetric_b, result, progress);
@@ -350,12 +351,13 @@ std::vector<double> GarmentBinding::lifts_from_pushes(const BodySurface& surface
   return lift;
 }
 
-TriangleFrames GarmentBinding::warp_step(const BodyMesh& body_b, ResizeResult& result, const Progress& progress) const {
+TriangleChange GarmentBinding::warp_step(const BodyMesh& body_b, const TriangleFrames& frames_b, ResizeResult& result,
+                                         const Progress& progress) const {
   const Stopwatch clock;
   progress.stage("warping to " + body_b.name);
-  TriangleFrames frames_b = compute_frames(body_b);
   check_body_b_scale(body_a_.mesh(), body_b, frames_b);
-  result.warped = warp_.apply(frames_b);
+  TriangleChange change_b = triangle_change(body_a_.frames(), frames_b);
+  result.warped = warp_.apply(change_b);
   result.report["timings_ms"]["warp"] = clock.ms();
   result.report["warp"] = {{"alpha", options_.warp.alpha},
                            {"max_triangles", options_.warp.max_triangles},
@@ -367,7 +369,7 @@ TriangleFrames GarmentBinding::warp_step(const BodyMesh& body_b, ResizeResult& r
                               std::to_string(frames_b.degenerate) + " on body B were skipped");
   if (!result.warped.allFinite()) throw Error("internal: the warp produced a non-finite position");
   result.positions = result.warped;
-  return frames_b;
+  return change_b;
 }
 
 // Symmetrise only when body B is symmetric too (the same vertices as body A's, mirrored).
@@ -390,7 +392,7 @@ const FoldBinding& GarmentBinding::folds_once() const {
   return folds_;
 }
 
-void GarmentBinding::feature_step(const TriangleFrames& frames_b, const BodySurface& surface_b, bool symmetric_b,
+void GarmentBinding::feature_step(const TriangleChange& change_b, const BodySurface& surface_b, bool symmetric_b,
                                   const std::vector<double>& lift, ResizeResult& result,
                                   const Progress& progress) const {
   const Stopwatch clock;
@@ -417,7 +419,7 @@ void GarmentBinding::feature_step(const TriangleFrames& frames_b, const BodySurf
     for (std::size_t i = 0; i < lift.size(); ++i) extra[i] = std::max(extra[i], lift[i] - base);
   }
   curves = optimise_features(
-      *features_, frames_b, [&](const Vec3& p) { return surface_b.closest(p).distance; },
+      *features_, change_b, [&](const Vec3& p) { return surface_b.closest(p).distance; },
       [&](const Vec3& p, double clearance) { return clearance_need(surface_b, p, clearance); }, extra);
   if (symmetric_b && !feature_mirror_.empty()) {
     symmetrise_curves(curves, feature_mirror_, mirror_.plane_x());

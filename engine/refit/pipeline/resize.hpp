@@ -100,14 +100,16 @@ class GarmentBinding {
   void check_memory_estimate();
   // The steps of resize(), in the paper's order; each adds its part of the
   // report, its time and its warnings to `result`.
-  TriangleFrames warp_step(const BodyMesh& body_b, ResizeResult& result, const Progress& progress) const;
+  /// Returns the change to body B (its frames `frames_b`), made once for every point set warped to it.
+  TriangleChange warp_step(const BodyMesh& body_b, const TriangleFrames& frames_b, ResizeResult& result,
+                           const Progress& progress) const;
   bool body_b_symmetric(const BodyMesh& body_b, nlohmann::json& report) const;
   /// `lift`: per feature sample (or empty), a clearance it keeps at least beyond the option's.
-  void feature_step(const TriangleFrames& frames_b, const BodySurface& surface_b, bool symmetric_b,
+  void feature_step(const TriangleChange& change_b, const BodySurface& surface_b, bool symmetric_b,
                     const std::vector<double>& lift, ResizeResult& result, const Progress& progress) const;
   /// Steps 2 to 4 on `result` (warped): features, surface, collision. Returns
   /// the feature samples carried where the surface step leaves them.
-  Points shape_steps(const TriangleFrames& frames_b, const BodySurface& surface_b, bool symmetric_b,
+  Points shape_steps(const TriangleChange& change_b, const BodySurface& surface_b, bool symmetric_b,
                      const std::vector<double>& lift, ResizeResult& result, const Progress& progress) const;
   /// Per feature sample: the clearance from body B that keeps it where the
   /// collision step pushed it (carried from `before` to `after`), for the
