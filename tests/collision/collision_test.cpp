@@ -414,31 +414,38 @@ TEST(Collision, AGivenVertexAdjacencyGivesTheSameResult) {
 // go up with it (the shared suit on M_heavier: the trousers through the jacket).
 // The check is a ray from the sphere's centre through each inner vertex, cut
 // with the outer shell's triangles.
-TEST(Collision, AnInnerLayerPushedOffTheBodyStaysUnderTheOuterOne) {
-  const BodyMesh sphere = sphere_body(4, 10.0);
-  const BodySurface body(sphere);
-  const Garment inner = sphere_garment(3, 10.1), outer = sphere_garment(2, 10.28);
+// Two icosphere shells about a sphere body of radius 10: the inner one (layer 1)
+// and the outer one over it (layer 2), with their layer covers (gap 0.03).
+// Subdivision levels 3 and 2 unless given.
+struct Shells {
+  BodyMesh sphere = sphere_body(4, 10.0);
   Garment g;
-  g.positions.resize(inner.positions.rows() + outer.positions.rows(), 3);
-  g.positions << inner.positions, outer.positions;
-  for (std::size_t f = 0; f < inner.faces.rows(); ++f) g.faces.push_row(inner.faces.row(f));
-  const auto first_outer = Index(inner.positions.rows());
-  for (std::size_t f = 0; f < outer.faces.rows(); ++f) {
-    std::array<Index, 3> t;
-    for (int k = 0; k < 3; ++k) t[std::size_t(k)] = outer.faces.row(f)[std::size_t(k)] + first_outer;
-    g.faces.push_row(t);
+  Garment outer;
+  Index first_outer = 0;
+  std::vector<LayerCover> covers;
+
+  Shells(double inner_radius, double outer_radius, int inner_level = 3, int outer_level = 2) {
+    const BodySurface body(sphere);
+    const Garment inner = sphere_garment(inner_level, inner_radius);
+    outer = sphere_garment(outer_level, outer_radius);
+    g.positions.resize(inner.positions.rows() + outer.positions.rows(), 3);
+    g.positions << inner.positions, outer.positions;
+    for (std::size_t f = 0; f < inner.faces.rows(); ++f) g.faces.push_row(inner.faces.row(f));
+    first_outer = Index(inner.positions.rows());
+    for (std::size_t f = 0; f < outer.faces.rows(); ++f) {
+      std::array<Index, 3> t;
+      for (int k = 0; k < 3; ++k) t[std::size_t(k)] = outer.faces.row(f)[std::size_t(k)] + first_outer;
+      g.faces.push_row(t);
+    }
+    std::vector<std::uint32_t> layer(g.vertex_count(), 1);
+    std::fill(layer.begin() + first_outer, layer.end(), 2u);
+    covers = bind_layer_order(g, layer, body, 2.0, 0.03);
   }
-  std::vector<std::uint32_t> layer(g.vertex_count(), 1);
-  std::fill(layer.begin() + first_outer, layer.end(), 2u);
-  const std::vector<LayerCover> covers = bind_layer_order(g, layer, body, 2.0, 0.03);
-  ASSERT_GT(covers.size(), inner.vertex_count() / 2) << "the outer shell covers the inner one";
-  for (const LayerCover& c : covers) {
-    EXPECT_LT(c.inner, first_outer) << "only the inner shell is covered";
-    EXPECT_GT(cover_height(c, g.positions).first, 0.0);
-  }
+
   // Where each inner vertex lies under the outer shell: how far out along its
-  // ray the outer shell is, less the vertex's own distance from the centre.
-  const auto below_outer = [&](const Points& x) {
+  // ray the outer shell is, less the vertex's own distance from the centre
+  // (the least over the inner vertices).
+  double below_outer(const Points& x) const {
     double least = std::numeric_limits<double>::infinity();
     for (Index i = 0; i < first_outer; ++i) {
       const Vec3 d = row3(x, i).normalized();
@@ -456,7 +463,21 @@ TEST(Collision, AnInnerLayerPushedOffTheBodyStaysUnderTheOuterOne) {
       }
     }
     return least;
-  };
+  }
+};
+
+TEST(Collision, AnInnerLayerPushedOffTheBodyStaysUnderTheOuterOne) {
+  const Shells s(10.1, 10.28);
+  const BodySurface body(s.sphere);
+  const Garment& g = s.g;
+  const std::vector<LayerCover>& covers = s.covers;
+  const Index first_outer = s.first_outer;
+  ASSERT_GT(covers.size(), std::size_t(first_outer) / 2) << "the outer shell covers the inner one";
+  for (const LayerCover& c : covers) {
+    EXPECT_LT(c.inner, first_outer) << "only the inner shell is covered";
+    EXPECT_GT(cover_height(c, g.positions).first, 0.0);
+  }
+  const auto below_outer = [&](const Points& x) { return s.below_outer(x); };
   ASSERT_GT(below_outer(g.positions), 0.0) << "the input has the outer shell over the inner one";
 
   Points without = g.positions, with = g.positions;
@@ -481,6 +502,29 @@ TEST(Collision, AnInnerLayerPushedOffTheBodyStaysUnderTheOuterOne) {
     resolve_penetrations(g, one, body, o);
   }
   EXPECT_TRUE(one == with);
+}
+
+// An inner layer its faces push out, round after round, takes the layer over it
+// along: a coarse inner shell whose corners clear the body and whose faces'
+// middles do not. Taken down under the outer shell by its cover, it was pushed
+// out again by its faces in the next round, and ended through the outer shell
+// (the real outfit's jeans through the dress at the back waist).
+TEST(Collision, AnInnerLayerItsFacesPushOutTakesTheLayerOverAlong) {
+  const Shells s(10.5, 10.75, 1, 3);
+  const BodySurface body(s.sphere);
+  ASSERT_GT(s.covers.size(), std::size_t(s.first_outer) / 2);
+  ASSERT_GT(s.below_outer(s.g.positions), 0.0) << "the input has the outer shell over the inner one";
+  for (Index i = 0; i < s.first_outer; ++i) ASSERT_GT(body.closest(row3(s.g.positions, i)).distance, 0.4);
+  CollisionOptions o;
+  o.layers = &s.covers;
+  Points x = s.g.positions;
+  const CollisionReport r = resolve_penetrations(s.g, x, body, o);
+  EXPECT_GT(r.faces_inside_before, 0u) << "the inner shell's faces must dip into the body";
+  EXPECT_EQ(r.inside_after, 0u);
+  EXPECT_EQ(r.faces_inside_after, 0u);
+  EXPECT_EQ(r.layers_crossed_after, 0u);
+  EXPECT_GT(s.below_outer(x), 0.0);
+  EXPECT_EQ(measure_sanity(s.g, x).flipped_faces, 0u);
 }
 
 }  // namespace

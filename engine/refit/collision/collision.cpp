@@ -357,6 +357,9 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   };
   std::vector<Vec3> first_position;  // aligned with `touched`: where each started
   std::vector<Index> touched_slot(n, 0);  // a touched vertex's slot in `touched`
+  // Per vertex: pushed out by the body or its faces in the last round (with layers).
+  std::vector<std::uint8_t> pushed_out(options.layers ? n : 0, 0);
+  std::vector<Index> pushed_list;
   // Per layer cover: its inner vertex's distance to body B at the step's start.
   std::vector<double> cover_start(options.layers ? options.layers->size() : 0, std::numeric_limits<double>::infinity());
 
@@ -472,6 +475,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     // vertex goes down by what it may (the outer layer is what shows, and the
     // feature curves sit on it); the rest the outer triangle's corners take,
     // outward, each its least-squares share (as for a face sample).
+    const std::size_t face_blocks = face_found.size();  // the faces' own, before the layers'
     if (options.layers) {
       const auto& covers = *options.layers;
       face_found.emplace_back();
@@ -492,9 +496,19 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
             const double short_by = c.keep - height;
             // It sinks by at most max_lift from where the step found it, as a vertex
             // near the body rises by at most that beyond its need.
-            const bool inner_pinned = options.pinned && (*options.pinned)[c.inner];
+            // Nor when the body or its faces push it out, in this round or the one
+            // before: taken down, it was lifted again by the next push, round after
+            // round, and ended through the layer over it (the real outfit on
+            // F_taller: the jeans through the dress at the back waist, 15 covers
+            // short after the step); the layer over it goes up instead, unless a
+            // corner of it is pinned (beside a curve, where moving it took the
+            // written garment off the curves).
+            const auto pinned = [&](Index v) { return options.pinned && (*options.pinned)[v]; };
+            const bool inner_pinned = pinned(c.inner);
+            const bool pushed = (constrained[c.inner] || pushed_out[c.inner]) && !pinned(c.outer[0]) &&
+                                !pinned(c.outer[1]) && !pinned(c.outer[2]);
             const double floor = std::max(options.clearance, cover_start[k] - options.max_lift);
-            const double room = inner_pinned                         ? 0.0
+            const double room = inner_pinned || pushed                ? 0.0
                                 : std::isfinite(near_distance[c.inner]) ? near_distance[c.inner] - floor
                                                                         : short_by;
             const double down = std::clamp(room, 0.0, short_by), up = short_by - down;
@@ -528,6 +542,15 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     std::vector<Index> active;  // ascending
     std::vector<Constraint> con;  // aligned with `active`
     merge_constraints(found, face_found, active, con);
+    if (options.layers) {  // what the body pushes out in this round, for the covers of the next
+      for (Index i : pushed_list) pushed_out[i] = 0;
+      pushed_list.clear();
+      for (const auto& list : found)
+        for (const auto& ic : list) pushed_list.push_back(ic.first);
+      for (std::size_t b = 0; b < face_blocks; ++b)
+        for (const auto& ic : face_found[b]) pushed_list.push_back(ic.first);
+      for (Index i : pushed_list) pushed_out[i] = 1;
+    }
     if (all) {
       report.too_close = vertex_constraints;
       for (const auto& list : found)
