@@ -7,6 +7,7 @@
 #include "report_file.hpp"
 
 #include <refit/chunked/chunked_resize.hpp>
+#include <refit/chunked/garment_store.hpp>
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
 #include <refit/io/atomic_file.hpp>
@@ -307,6 +308,11 @@ int run(ResizeArgs a) {
                    " MB in all)");
     obj->set_group_bytes(plan.group_bytes);
     auto store = std::make_shared<const GarmentStore>(std::move(*obj), plan.folder);
+    if (store->vertex_count() > 0) {
+      Points sample;
+      PointGather(store->positions(), 0).gather(depth_check_sample(store->vertex_count()), sample);
+      check_garment_over_body_a(sample, store->low(), store->high(), a.garment, body_a, units_per_cm(a.units));
+    }
     run.load_ms = clock.ms();
     run.garment = store->summary();
     run.garment_warnings = store->warnings();
@@ -327,6 +333,13 @@ int run(ResizeArgs a) {
   // The file's text is read again chunk by chunk when each body is written: kept,
   // it was the largest single part of a dense garment's peak memory (bench/README.md).
   auto garment = std::make_shared<const Garment>(read_garment_obj(a.garment, SourceText::released));
+  if (garment->vertex_count() > 0) {
+    const std::vector<Index> ids = depth_check_sample(garment->vertex_count());
+    Points sample(Eigen::Index(ids.size()), 3);
+    for (std::size_t k = 0; k < ids.size(); ++k) sample.row(Eigen::Index(k)) = garment->positions.row(ids[k]);
+    check_garment_over_body_a(sample, garment->positions.colwise().minCoeff().transpose(),
+                              garment->positions.colwise().maxCoeff().transpose(), a.garment, body_a, units_per_cm(a.units));
+  }
   run.load_ms = clock.ms();
   // The heap grown to the run's estimated peak at once, on every thread (heap.hpp).
   // The estimate is the whole pipeline's: a run that stops short of the collision
