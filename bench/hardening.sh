@@ -25,6 +25,8 @@ def transform(src, dst, f, head=''):
 transform(D + '/bodies/A_female.obj', W + '/A_mm.obj', lambda p: [10 * x for x in p])
 transform(D + '/bodies/F_heavier.obj', W + '/B_mm.obj', lambda p: [10 * x for x in p])
 transform(D + '/bodies/F_heavier.obj', W + '/B_point.obj', lambda p: [0, 100, 0])
+transform(D + '/garments/skirt_on_A_female.obj', W + '/skirt_in.obj', lambda p: [x / 2.54 for x in p])
+transform(D + '/garments/skirt_on_A_female.obj', W + '/skirt_m.obj', lambda p: [x / 100 for x in p])
 g = open(D + '/garments/skirt_on_A_female.obj').read()
 first = g.index('\nv ') + 1
 open(W + '/skirt_bom.obj', 'w').write('\ufeff' + g[first:])
@@ -61,6 +63,8 @@ run clearance_1e6   resize --quiet --garment "$G" --from "$A" --to "$B" --out "$
 run clearance_nan   resize --quiet --garment "$G" --from "$A" --to "$B" --out "$W/out/o.obj" --clearance nan
 run units_furlong   resize --quiet --garment "$G" --from "$A" --to "$B" --out "$W/out/o.obj" --units furlong --features "$W/far.json"
 run huge_coords     resize --quiet --garment "$W/huge_coords.obj" --from "$A" --to "$B" --out "$W/out/o.obj"
+run garment_in_in   resize --quiet --garment "$W/skirt_in.obj" --from "$A" --to "$B" --out "$W/out/o.obj"
+run garment_in_m    resize --quiet --garment "$W/skirt_m.obj" --from "$A" --to "$B" --out "$W/out/o.obj"
 run out_is_garment  resize --quiet --garment "$G" --from "$A" --to "$B" --out "$G"
 run out_dev_null    resize --quiet --garment "$G" --from "$A" --to "$B" --out /dev/null
 run report_eq_out   resize --quiet --garment "$G" --from "$A" --to "$B" --out "$W/out/x" --report "$W/out/x"

@@ -105,6 +105,27 @@ TEST(Folds, ACrumpleIsSmoothedOutAndTheRestKept) {
       EXPECT_TRUE(p.row(v) == smooth.row(v)) << v;
 }
 
+// A 7 x 7 patch shifted 4 spacings along the grid: the faces on its leading
+// side fold, and one ring around them cannot take the patch's shift. Each round
+// after the first smooths as many rings more around what is left as rounds have
+// run. Before, a fold left over added nothing to the region (its corners were in
+// it already): the same region was smoothed again, and the second round, leaving
+// no fewer folds, ended the smoothing with 5 (6 counted here).
+TEST(Folds, AFoldLeftOverGetsAWiderRegion) {
+  const Grid grid;
+  Points p = deformed(grid.g, grid.map);
+  for (int i = 7; i <= 13; ++i)
+    for (int k = 7; k <= 13; ++k) p.row(i * kSide + k) += (grid.map * Vec3(4.0 * kSpacing, 0.0, 0.0)).transpose();
+  ASSERT_GE(folds_against(grid.g, p, grid.map), 2u);
+  FoldOptions narrow;
+  narrow.rings = 1;
+  narrow.reshape_rounds = 0;  // the rounds alone
+  const FoldReport r = smooth_out_folds(grid.g, grid.binding, p, grid.adjacency, nullptr, narrow);
+  EXPECT_GE(r.rounds, 3);
+  EXPECT_EQ(r.folded_after, 0u);
+  EXPECT_EQ(folds_against(grid.g, p, grid.map), 0u);
+}
+
 TEST(Folds, PinnedVerticesKeepTheirPlace) {
   const Grid grid;
   Points p = crumpled(grid.g, grid.map);

@@ -14,9 +14,9 @@
 namespace refit {
 
 struct FoldOptions {
-  int rings = 2;       // the smoothed region: the folded faces' corners and this many rings around them
+  int rings = 2;       // the smoothed region: the folded faces' corners and this many rings around them (times the round)
   int passes = 10;     // Jacobi passes of the smoothing per round
-  int max_rounds = 5;  // re-detect and smooth again (the region grown by `rings`) while folds are left
+  int max_rounds = 5;  // re-detect and smooth again (the region grown around what is left) while folds are left
   int reshape_rounds = 5;  // then faces leaning over 60 degrees take their original shape, turned as around (folds.cpp)
 };
 
