@@ -103,6 +103,12 @@ TEST(CliInputChecks, AGarmentInOtherUnitsThanTheBodies) {
   for (const std::string extra : {"", "--stage warp", "--no-collision --chunk-vertices 97"})
     expect_refused(run_cli(c.run(inches, c.a, c.b, extra)), inches, "inside body A", c.out_dir);
   expect_refused(run_cli(c.run(metres, c.a, c.b)), metres, "a dot beside body A", c.out_dir);
+  // A garment that small on purpose (eyelashes are 3 cm) is resized.
+  const std::string patch = c.dir.file("patch.obj");
+  test::write_text(patch, "v -1.5 100 14\nv 1.5 100 14\nv 1.5 103 14\nv -1.5 103 14\nf 1 2 3 4\n");
+  const auto small = run_cli("resize --quiet --stage warp --garment '" + patch + "' --from '" + c.a + "' --to '" + c.b +
+                             "' --out '" + c.dir.file("patch_on_B.obj") + "'");
+  EXPECT_EQ(small.exit_code, 0) << small.err;
 
   const std::string data = test::shared_data_dir();
   if (data.empty()) GTEST_SKIP() << "../shared/data is absent: the shared skirt in inches skipped";

@@ -76,7 +76,7 @@ void check_garment_over_body_a(const Points& sample, const Vec3& lo, const Vec3&
   const double height = (body_a.vertices.colwise().maxCoeff() - body_a.vertices.colwise().minCoeff()).maxCoeff();
   const double across = (hi - lo).maxCoeff();
   const std::string units = units_name(units_per_cm);
-  if (across < 0.02 * height)
+  if (across < 0.01 * height)
     throw input_error(garment_file, "the garment is " + number(across) + " " + units + " across, a dot beside body A (" +
                                         file_of(body_a) + ", " + number(height) + " " + units +
                                         " tall): is it in the same units as the bodies?");

@@ -31,10 +31,10 @@ void check_garment_on_body_a(const Vec3& lo, const Vec3& hi, const std::string& 
 std::vector<Index> depth_check_sample(std::size_t vertex_count);
 
 /// For files of people (the command line; a library may bind a point): the
-/// garment, whose positions' box is [lo, hi], is at least a fiftieth of body A's
-/// height across, and is fitted over body A, not inside it: at most a third of
-/// the `sample`d vertices (positions of depth_check_sample's) lie inside body A
-/// deeper than a hundredth of its height. The shared garments have none that
+/// garment, whose positions' box is [lo, hi], is at least a hundredth of body A's
+/// height across (eyelashes are 3 cm), and is fitted over body A, not inside it:
+/// at most a third of the `sample`d vertices (positions of depth_check_sample's)
+/// lie inside body A deeper than a hundredth of its height. The shared garments have none that
 /// deep; in inches on bodies in cm, 52-65 % of their vertices are, and the
 /// collision step pushed the whole garment out of the body with exit 0 (in m,
 /// 0.8 cm across, it was resized as a dot). Throws refit::Error naming the
