@@ -521,7 +521,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
             // such a face to its pinned corners).
             std::array<double, 3> w = c.weight;
             for (int j = 0; j < 3; ++j)
-              if (options.pinned && (*options.pinned)[c.outer[std::size_t(j)]]) w[std::size_t(j)] = 0.0;
+              if (pinned(c.outer[std::size_t(j)])) w[std::size_t(j)] = 0.0;
             if (!(w[0] + w[1] + w[2] >= 0.5)) continue;
             const double norm2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
             for (int j = 0; j < 3; ++j)
