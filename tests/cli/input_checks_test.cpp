@@ -92,7 +92,7 @@ TEST(CliInputChecks, AGarmentAwayFromBodyAOrWithHugeCoordinates) {
 // out of the body by the collision step, or resized as a dot. Scaled about its
 // own centre, as a MakeHuman file's origin is at the pelvis (the mannequin's is
 // at its feet, where a garment in inches lands around the shins, only a fifth of
-// it deep inside the legs: not refused, docs/cli.md).
+// it deep inside the legs: not refused, docs/cli-errors.md).
 TEST(CliInputChecks, AGarmentInOtherUnitsThanTheBodies) {
   const Checked c;
   const Garment g = read_garment_obj(c.garment);

@@ -1,14 +1,14 @@
-#include <refit/body/body_surface.hpp>
-#include <refit/body/centre_tree.hpp>
-#include <refit/core/error.hpp>
-#include <refit/io/obj_garment.hpp>
 #include <refit/pipeline/input_checks.hpp>
 
+#include <refit/body/body_surface.hpp>  // closest_point_on_triangle
+#include <refit/body/centre_tree.hpp>
+#include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
+#include <refit/io/obj_garment.hpp>
 
 #include <algorithm>
-#include <limits>
 #include <cstdio>
+#include <limits>
 #include <utility>
 
 namespace refit {

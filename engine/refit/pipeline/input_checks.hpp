@@ -34,11 +34,11 @@ std::vector<Index> depth_check_sample(std::size_t vertex_count);
 /// garment, whose positions' box is [lo, hi], is at least a hundredth of body A's
 /// height across (eyelashes are 3 cm), and is fitted over body A, not inside it:
 /// at most a third of the `sample`d vertices (positions of depth_check_sample's)
-/// lie inside body A deeper than a hundredth of its height. The shared garments have none that
-/// deep; in inches on bodies in cm, 52-65 % of their vertices are, and the
-/// collision step pushed the whole garment out of the body with exit 0 (in m,
-/// 0.8 cm across, it was resized as a dot). Throws refit::Error naming the
-/// garment's file.
+/// lie inside body A deeper than a hundredth of its height. The shared garments
+/// have none that deep; in inches on bodies in cm, 52-65 % of their vertices
+/// are, and the collision step pushed the whole garment out of the body with
+/// exit 0 (in m, 0.8 cm across, it was resized as a dot). Throws refit::Error
+/// naming the garment's file.
 void check_garment_over_body_a(const Points& sample, const Vec3& lo, const Vec3& hi, const std::string& garment_file,
                                const BodyMesh& body_a, double units_per_cm);
 
