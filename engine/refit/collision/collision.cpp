@@ -772,8 +772,8 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   // what was inside: that can push a vertex through the layer over it again (in
   // the first 3 only, the real outfit on F_taller ended with the jeans 0.06 cm
   // through the dress: none crossed after round 3, one after round 4, a round
-  // over what was inside). Not in every round: a cover the rounds cannot meet
-  // (its outer corners held by a curve) would run them all.
+  // over what was inside). Not in every round: a cover each round leaves a
+  // hair short (the 1M dress: 0.0003 cm of its 0.03 cm gap) would run them all.
   const auto layers_left = [&](std::vector<Index>& check) {
     if (!options.layers) return;
     for (const LayerCover& c : *options.layers)
