@@ -95,7 +95,8 @@ TEST(LayersSharedData, SuitTrousersStayUnderTheJacket) {
 // The outfit's jeans under the dress at the back waist: the collision step's
 // last rounds, which push out what is still inside body B, took the layers in
 // their first 3 only, and the fourth pushed a jeans vertex 0.06 cm through the
-// dress on F_taller (0.03 cm on F_heavier). Now every such round keeps them.
+// dress on F_taller (0.03 cm on F_heavier). Now a round after one that pushed
+// something out of the body takes them too.
 TEST(LayersSharedData, OutfitJeansStayUnderTheDress) {
   const auto outfit = test::shared_case("outfit_dress_jeans");
   if (!outfit) GTEST_SKIP() << "../shared/data is absent: real-data layer test skipped";
