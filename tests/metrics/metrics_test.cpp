@@ -200,6 +200,50 @@ TEST(Render, WritesAPngOfTheRequestedSizeWithContent) {
   EXPECT_THROW(render(body, dress, nullptr, curves, o), Error);
 }
 
+// Pixels that are not background within [x0, x1) x [y0, y1).
+std::size_t content(const Image& img, int x0, int y0, int x1, int y1) {
+  std::size_t count = 0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) {
+      const std::uint8_t* p = &img.rgb[3 * (std::size_t(y) * std::size_t(img.width) + std::size_t(x))];
+      count += p[0] != kBackground[0] || p[1] != kBackground[1] || p[2] != kBackground[2];
+    }
+  return count;
+}
+
+TEST(Render, AZoomMagnifiesEachPanelAboutTheGivenPoint) {
+  mannequin::BodyParams bp;
+  const BodyMesh body = mannequin::make_body(bp);
+  mannequin::GarmentParams gp;
+  gp.target_vertices = 4000;
+  const Garment dress = mannequin::make_garment(bp, gp);
+  RenderOptions o;
+  o.width = 300;
+  o.height = 400;
+  o.views = {View::front};
+  const Image whole = render(body, dress, nullptr, {}, o);
+  // Zoomed 2x about a point, the picture shows the window of half its size
+  // around that point of the whole picture: 4x the pixels for the same content.
+  const auto check = [&](double cx, double cy) {
+    o.zoom = 2.0;
+    o.centre_x = cx;
+    o.centre_y = cy;
+    const Image zoomed = render(body, dress, nullptr, {}, o);
+    const int x0 = int(std::lround(cx * o.width - o.width / 4.0)), y0 = int(std::lround(cy * o.height - o.height / 4.0));
+    const double window = double(content(whole, x0, y0, x0 + o.width / 2, y0 + o.height / 2));
+    ASSERT_GT(window, 1000.0);
+    EXPECT_NEAR(double(content(zoomed, 0, 0, o.width, o.height)) / (4.0 * window), 1.0, 0.03) << cx << ", " << cy;
+  };
+  check(0.5, 0.5);
+  check(0.4, 0.3);   // the chest, left of the middle
+  check(0.55, 0.75); // the legs
+  o.zoom = 0.5;
+  EXPECT_THROW(render(body, dress, nullptr, {}, o), Error);
+  o.zoom = 2.0;
+  o.centre_y = 1.5;
+  EXPECT_THROW(render(body, dress, nullptr, {}, o), Error);
+}
+
 // -- the commands ---------------------------------------------------------------
 
 bool cli_built() { return std::filesystem::exists(REFIT_CLI_PATH); }
@@ -270,6 +314,25 @@ TEST(RenderCommand, WritesThePicture) {
                                  "/garments/skirt_on_A_female.obj' --size 320by200 --out '" + tmp.file("q.png") + "'");
   EXPECT_NE(bad.exit_code, 0);
   EXPECT_NE(bad.err.find("--size"), std::string::npos) << bad.err;
+  // A detail: the waist magnified 6 times fills the picture.
+  const auto zoomed = test::run_cli("render --body '" + dir + "/bodies/A_female.obj' --garment '" + dir +
+                                    "/garments/skirt_on_A_female.obj' --size 320x200 --zoom 6 --centre 0.5,0.45 --out '" +
+                                    tmp.file("z.png") + "'");
+  ASSERT_EQ(zoomed.exit_code, 0) << zoomed.err;
+  data = stbi_load(tmp.file("z.png").c_str(), &w, &h, &ch, 3);
+  ASSERT_NE(data, nullptr);
+  std::size_t background = 0;
+  for (int i = 0; i < w * h; ++i) background += data[3 * i] == 255 && data[3 * i + 1] == 255 && data[3 * i + 2] == 255;
+  stbi_image_free(data);
+  EXPECT_LT(background, (std::size_t(w * h) - content) / 2);  // the whole body's picture is mostly background
+  for (const char* centre : {"0.5", "0.5;0.4", "2,0.5"}) {
+    const auto wrong = test::run_cli("render --body '" + dir + "/bodies/A_female.obj' --garment '" + dir +
+                                     "/garments/skirt_on_A_female.obj' --zoom 2 --centre '" + centre + "' --out '" +
+                                     tmp.file("w.png") + "'");
+    EXPECT_NE(wrong.exit_code, 0) << centre;
+    EXPECT_NE(wrong.err.find("centre"), std::string::npos) << wrong.err;
+    EXPECT_FALSE(std::filesystem::exists(tmp.file("w.png")));
+  }
 }
 
 }  // namespace

@@ -119,6 +119,11 @@ def test_render(demo, tmp_path):
     assert picture.shape == (240, 200, 3)
     assert (picture != 255).any()  # something was drawn on the white background
     assert (tmp_path / "p.png").stat().st_size > 0
+    # Magnified 4x about the middle, the body fills far more of the picture.
+    zoomed = refit.render(refit.read_body(str(demo / "A.obj")), g, width=200, height=240, zoom=4.0, centre=(0.5, 0.5))
+    assert (zoomed != 255).any(axis=2).mean() > 2 * (picture != 255).any(axis=2).mean()
+    with pytest.raises(Exception, match="zoom"):
+        refit.render(refit.read_body(str(demo / "A.obj")), g, width=200, height=240, zoom=0.5)
 
 
 def test_shared_dress_to_two_bodies(tmp_path):

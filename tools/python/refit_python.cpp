@@ -354,7 +354,7 @@ PYBIND11_MODULE(_refit, m) {
   m.def(
       "render",
       [](const BodyMesh& body, const Garment& garment, const py::object& positions, const std::string& path,
-         const std::vector<std::string>& views, int width, int height) {
+         const std::vector<std::string>& views, int width, int height, double zoom, std::pair<double, double> centre) {
         Garment shown = garment;
         if (!positions.is_none()) {
           shown.positions = python::points_from(positions.cast<py::array_t<double, py::array::forcecast>>(), "render");
@@ -364,6 +364,9 @@ PYBIND11_MODULE(_refit, m) {
         RenderOptions o;
         o.width = width;
         o.height = height;
+        o.zoom = zoom;
+        o.centre_x = centre.first;
+        o.centre_y = centre.second;
         o.views.clear();
         for (const std::string& v : views) {
           if (v != "front" && v != "side" && v != "back")
@@ -382,6 +385,8 @@ PYBIND11_MODULE(_refit, m) {
       },
       py::arg("body"), py::arg("garment"), py::arg("positions") = py::none(), py::arg("path") = "",
       py::arg("views") = std::vector<std::string>{"front"}, py::arg("width") = 800, py::arg("height") = 1000,
+      py::arg("zoom") = 1.0, py::arg("centre") = std::pair<double, double>{0.5, 0.5},
       "Ray-traced picture of the body with the garment (at `positions` if given), one panel per view: an "
-      "H x W x 3 uint8 array, also written as PNG when `path` is given (as `refit render`).");
+      "H x W x 3 uint8 array, also written as PNG when `path` is given (as `refit render`). `zoom` magnifies "
+      "each panel about `centre` (x, y as fractions of a panel at zoom 1; refit render --zoom --centre).");
 }

@@ -17,7 +17,8 @@ namespace refit::cli {
 namespace {
 
 struct RenderArgs {
-  std::string body, garment, garment2, curves, out, views = "front", size = "800x1000", labels, title;
+  std::string body, garment, garment2, curves, out, views = "front", size = "800x1000", labels, title, centre = "0.5,0.5";
+  double zoom = 1.0;
 };
 
 RenderOptions parse_options(const RenderArgs& a) {
@@ -35,6 +36,14 @@ RenderOptions parse_options(const RenderArgs& a) {
   std::stringstream ls(a.labels);
   for (std::string l; std::getline(ls, l, ',');) o.labels.push_back(l);
   o.title = a.title;
+  o.zoom = a.zoom;
+  double cx = 0.0, cy = 0.0;
+  char comma = 0;
+  std::istringstream cs(a.centre);
+  if (!(cs >> cx >> comma >> cy) || comma != ',' || (cs >> extra))
+    throw Error("--centre: expected X,Y as fractions of a panel (e.g. 0.4,0.55), got '" + a.centre + "'");
+  o.centre_x = cx;
+  o.centre_y = cy;
   return o;
 }
 
@@ -81,6 +90,10 @@ const Register render_command("render", "ray-traced PNG of a body with one or tw
                      app.add_option("--size", args->size, "picture size WIDTHxHEIGHT (default 800x1000)");
                      app.add_option("--labels", args->labels, "comma-separated labels over the garments, e.g. 'warp alone,Refit'");
                      app.add_option("--title", args->title, "title across the top, e.g. the body's name");
+                     app.add_option("--zoom", args->zoom, "magnify every panel (1 to 1000; default 1: the whole body)");
+                     app.add_option("--centre", args->centre,
+                                    "with --zoom: the point to magnify about, X,Y as fractions of a panel at zoom 1 "
+                                    "(0,0 top left; default 0.5,0.5)");
                      return [args] { return run(*args); };
                    });
 

@@ -131,6 +131,10 @@ Image render(const BodyMesh& body, const Garment& garment, const Garment* garmen
     throw Error("render: picture size " + std::to_string(options.width) + "x" + std::to_string(options.height) +
                 " is out of range (16 to 16384 per side)");
   if (options.views.empty()) throw Error("render: no view requested");
+  if (!(options.zoom >= 1.0 && options.zoom <= 1000.0))
+    throw Error("render: zoom " + std::to_string(options.zoom) + " is out of range (1 to 1000)");
+  if (!(options.centre_x >= 0.0 && options.centre_x <= 1.0 && options.centre_y >= 0.0 && options.centre_y <= 1.0))
+    throw Error("render: the zoom's centre must lie within the panel (0 to 1 across and down)");
 
   std::unique_ptr<RTCDeviceTy, void (*)(RTCDevice)> device(rtcNewDevice(nullptr), rtcReleaseDevice);
   if (!device) throw Error("render: cannot create an Embree device");
@@ -175,7 +179,12 @@ Image render(const BodyMesh& body, const Garment& garment, const Garment* garmen
     edge += across[i];
     panels[i].width = static_cast<int>(std::lround(edge / total * options.width)) - panels[i].x0;
   }
-  const std::vector<double> pixel(panels.size(), scale);
+  const std::vector<double> pixel(panels.size(), scale / options.zoom);
+  // Where each panel's zoom centre lies from the box's centre (right, up), at zoom 1.
+  std::vector<Eigen::Vector2d> shift(panels.size());
+  for (std::size_t i = 0; i < panels.size(); ++i)
+    shift[i] = Eigen::Vector2d((options.centre_x - 0.5) * panels[i].width * scale,
+                               (middle_y - band - options.centre_y * (options.height - band)) * scale);
 
   Image img;
   img.width = options.width;
@@ -192,8 +201,8 @@ Image render(const BodyMesh& body, const Garment& garment, const Garment* garmen
         const Panel& p = panels[pi];
         const Camera& c = p.camera;
         for (int x = p.x0; x < p.x0 + p.width; ++x) {
-          const double u = (x - p.x0 + 0.5 - 0.5 * p.width) * pixel[pi];
-          const double v = (middle_y - (static_cast<double>(y) + 0.5)) * pixel[pi];
+          const double u = (x - p.x0 + 0.5 - 0.5 * p.width) * pixel[pi] + shift[pi].x();
+          const double v = (middle_y - (static_cast<double>(y) + 0.5)) * pixel[pi] + shift[pi].y();
           const Vec3 o = centre + u * c.right + v * c.up - depth * c.forward;
           RTCRayHit rh = make_ray(o, c.forward);
           rtcIntersect1(scenes[static_cast<std::size_t>(p.garment)]->get(), &ctx, &rh);
@@ -217,10 +226,12 @@ Image render(const BodyMesh& body, const Garment& garment, const Garment* garmen
     if (p.garment != 0) continue;
     auto to_pixel = [&](const Vec3& q) {
       const Vec3 d = q - centre;
-      return Eigen::Vector2d(p.x0 + 0.5 * p.width + d.dot(p.camera.right) / pixel[pi],
-                             middle_y - d.dot(p.camera.up) / pixel[pi]);
+      return Eigen::Vector2d(p.x0 + 0.5 * p.width + (d.dot(p.camera.right) - shift[pi].x()) / pixel[pi],
+                             middle_y - (d.dot(p.camera.up) - shift[pi].y()) / pixel[pi]);
     };
     auto stamp = [&](const Eigen::Vector2d& s) {
+      if (s.y() + radius < 0.0 || s.y() - radius >= img.height || s.x() + radius < p.x0 || s.x() - radius >= p.x0 + p.width)
+        return;  // off the panel (a zoomed picture shows a small part of each curve)
       for (int y = static_cast<int>(std::floor(s.y() - radius)); y <= static_cast<int>(std::ceil(s.y() + radius)); ++y)
         for (int x = static_cast<int>(std::floor(s.x() - radius)); x <= static_cast<int>(std::ceil(s.x() + radius)); ++x) {
           if (y < 0 || y >= img.height || x < p.x0 || x >= p.x0 + p.width) continue;

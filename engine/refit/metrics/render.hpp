@@ -22,6 +22,12 @@ struct RenderOptions {
   std::vector<View> views = {View::front};
   std::vector<std::string> labels;  // written above garment 1's panels, then garment 2's (may be empty)
   std::string title;                // written across the top (may be empty)
+  /// Magnification of every panel about its point (centre_x, centre_y): fractions
+  /// of the panel's width and of the framed height at zoom 1 (0, 0: top left), so a
+  /// detail found on a whole-body picture is framed by where it shows there (a
+  /// 0.1 cm fold of a dense garment is a pixel at 1000 pixels a body).
+  double zoom = 1.0;
+  double centre_x = 0.5, centre_y = 0.5;
 };
 
 struct Image {
@@ -33,7 +39,8 @@ struct Image {
 /// (when given) on the right. Each panel shows the body and that garment; every
 /// polyline in `curves` is drawn on top of garment 1's panels as a thick line.
 /// `options.labels` and `options.title` are written in black on the background.
-/// Throws refit::Error for a size below 16x16 or above 16384 per side, or no view.
+/// Throws refit::Error for a size below 16x16 or above 16384 per side, no view, a
+/// zoom below 1 or above 1000, or a centre outside the panel (0 to 1).
 Image render(const BodyMesh& body, const Garment& garment, const Garment* garment2,
              const std::vector<Points>& curves, const RenderOptions& options);
 

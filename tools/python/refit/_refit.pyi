@@ -110,4 +110,6 @@ def render(
     views: Sequence[str] = ("front",),
     width: int = 800,
     height: int = 1000,
+    zoom: float = 1.0,
+    centre: tuple[float, float] = (0.5, 0.5),
 ) -> npt.NDArray[np.uint8]: ...
