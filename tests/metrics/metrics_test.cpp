@@ -156,12 +156,21 @@ TEST(Metrics, FlippedFacesOfAMirroredSheet) {
 
 // -- render ---------------------------------------------------------------------
 
-TEST(Render, WritesAPngOfTheRequestedSizeWithContent) {
+// The default mannequin and a 4000-vertex dress on it.
+struct Dressed {
   mannequin::BodyParams bp;
-  const BodyMesh body = mannequin::make_body(bp);
-  mannequin::GarmentParams gp;
-  gp.target_vertices = 4000;
-  const Garment dress = mannequin::make_garment(bp, gp);
+  BodyMesh body = mannequin::make_body(bp);
+  Garment dress = mannequin::make_garment(bp, [] {
+    mannequin::GarmentParams gp;
+    gp.target_vertices = 4000;
+    return gp;
+  }());
+};
+
+TEST(Render, WritesAPngOfTheRequestedSizeWithContent) {
+  const Dressed d;
+  const BodyMesh& body = d.body;
+  const Garment& dress = d.dress;
   std::vector<Points> curves(1, Points(2, 3));
   curves[0] << -20, 100, 30, 20, 100, 30;
   RenderOptions o;
@@ -212,11 +221,9 @@ std::size_t content(const Image& img, int x0, int y0, int x1, int y1) {
 }
 
 TEST(Render, AZoomMagnifiesEachPanelAboutTheGivenPoint) {
-  mannequin::BodyParams bp;
-  const BodyMesh body = mannequin::make_body(bp);
-  mannequin::GarmentParams gp;
-  gp.target_vertices = 4000;
-  const Garment dress = mannequin::make_garment(bp, gp);
+  const Dressed d;
+  const BodyMesh& body = d.body;
+  const Garment& dress = d.dress;
   RenderOptions o;
   o.width = 300;
   o.height = 400;
