@@ -15,6 +15,12 @@ shared data.
 
 Runs alternate between the thread counts. After each size's rows, the ratio of
 the first thread count's median total to each other's.
+
+--warm-up runs each size once, unmeasured, before its measured runs: on this project's
+virtual machine memory the process has not touched for a few seconds costs about 10
+ms/MB at its first touch (the host backs it again) against 0.3-0.6 ms/MB right after
+another process freed it, so a 4M run right after a 1M run pays for the 2 GB the 1M
+run did not use (bench/README.md, "4M against 1M, warm and cold").
 """
 import argparse
 import json
@@ -47,6 +53,7 @@ def main():
     ap.add_argument("--workdir", default=None)
     ap.add_argument("--garment", default="procedural", choices=["procedural"] + sorted(REAL))
     ap.add_argument("--data", default=os.path.join(HERE, "..", "..", "shared", "data"))
+    ap.add_argument("--warm-up", action="store_true", help="one unmeasured run of each size before its measured runs")
     a = ap.parse_args()
     work = a.workdir or tempfile.mkdtemp(prefix="refit-scal-")
     os.makedirs(work, exist_ok=True)
@@ -76,13 +83,17 @@ def main():
         # machine hits them alike and their ratio stays meaningful.
         reports = {t: [] for t in a.threads}
         walls = {t: [] for t in a.threads}
+        rep = os.path.join(work, "report.json")
+
+        def command(t):
+            cmd = [a.refit, "resize", "--garment", g, "--from", A, "--to", B, "--out", os.path.join(work, "out.obj"),
+                   "--report", rep, "--threads", str(t), "--quiet", "--stage", a.stage]
+            return cmd + (["--features", f] if a.stage != "warp" else [])
+        if a.warm_up:
+            run(command(a.threads[-1]))
         for _ in range(a.repeat):
             for t in a.threads:
-                rep = os.path.join(work, "report.json")
-                cmd = [a.refit, "resize", "--garment", g, "--from", A, "--to", B, "--out", os.path.join(work, "out.obj"),
-                       "--report", rep, "--threads", str(t), "--quiet", "--stage", a.stage]
-                if a.stage != "warp":
-                    cmd += ["--features", f]
+                cmd = command(t)
                 start = time.monotonic()
                 run(cmd)
                 walls[t].append(time.monotonic() - start)
