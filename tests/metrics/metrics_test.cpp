@@ -321,9 +321,9 @@ TEST(RenderCommand, WritesThePicture) {
                                  "/garments/skirt_on_A_female.obj' --size 320by200 --out '" + tmp.file("q.png") + "'");
   EXPECT_NE(bad.exit_code, 0);
   EXPECT_NE(bad.err.find("--size"), std::string::npos) << bad.err;
-  // A detail: the waist magnified 6 times fills the picture.
+  // A detail: the waist magnified 6 times fills the picture (--center: --centre's other spelling).
   const auto zoomed = test::run_cli("render --body '" + dir + "/bodies/A_female.obj' --garment '" + dir +
-                                    "/garments/skirt_on_A_female.obj' --size 320x200 --zoom 6 --centre 0.5,0.45 --out '" +
+                                    "/garments/skirt_on_A_female.obj' --size 320x200 --zoom 6 --center 0.5,0.45 --out '" +
                                     tmp.file("z.png") + "'");
   ASSERT_EQ(zoomed.exit_code, 0) << zoomed.err;
   data = stbi_load(tmp.file("z.png").c_str(), &w, &h, &ch, 3);

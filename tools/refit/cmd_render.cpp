@@ -91,7 +91,7 @@ const Register render_command("render", "ray-traced PNG of a body with one or tw
                      app.add_option("--labels", args->labels, "comma-separated labels over the garments, e.g. 'warp alone,Refit'");
                      app.add_option("--title", args->title, "title across the top, e.g. the body's name");
                      app.add_option("--zoom", args->zoom, "magnify every panel (1 to 1000; default 1: the whole body)");
-                     app.add_option("--centre", args->centre,
+                     app.add_option("--centre,--center", args->centre,
                                     "with --zoom: the point to magnify about, X,Y as fractions of a panel at zoom 1 "
                                     "(0,0 top left; default 0.5,0.5)");
                      return [args] { return run(*args); };
