@@ -21,15 +21,18 @@ struct RenderArgs {
   double zoom = 1.0;
 };
 
+// Two numbers joined by `sep` and nothing else ("800x1000", "0.4,0.55").
+template <class T>
+bool read_pair(const std::string& text, char sep, T& first, T& second) {
+  std::istringstream in(text);
+  char got = 0, extra = 0;
+  return (in >> first >> got >> second) && got == sep && !(in >> extra);
+}
+
 RenderOptions parse_options(const RenderArgs& a) {
   RenderOptions o;
-  int w = 0, h = 0;
-  char x = 0, extra = 0;
-  std::istringstream ss(a.size);
-  if (!(ss >> w >> x >> h) || x != 'x' || (ss >> extra))
+  if (!read_pair(a.size, 'x', o.width, o.height))
     throw Error("--size: expected WIDTHxHEIGHT (e.g. 800x1000), got '" + a.size + "'");
-  o.width = w;
-  o.height = h;
   o.views.clear();
   std::stringstream vs(a.views);
   for (std::string v; std::getline(vs, v, ',');) o.views.push_back(parse_view(v));
@@ -37,13 +40,8 @@ RenderOptions parse_options(const RenderArgs& a) {
   for (std::string l; std::getline(ls, l, ',');) o.labels.push_back(l);
   o.title = a.title;
   o.zoom = a.zoom;
-  double cx = 0.0, cy = 0.0;
-  char comma = 0;
-  std::istringstream cs(a.centre);
-  if (!(cs >> cx >> comma >> cy) || comma != ',' || (cs >> extra))
+  if (!read_pair(a.centre, ',', o.centre_x, o.centre_y))
     throw Error("--centre: expected X,Y as fractions of a panel (e.g. 0.4,0.55), got '" + a.centre + "'");
-  o.centre_x = cx;
-  o.centre_y = cy;
   return o;
 }
 
