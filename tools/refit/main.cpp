@@ -34,18 +34,22 @@ std::vector<CommandInfo>& registry() {
 
 namespace {
 
-// Large buffers on transparent huge pages. A garment of a million vertices
-// first-touches about a gigabyte, and on this kind of virtual machine each 4 KB
-// page fault is expensive: the dense 1M dress spent 3.4 s of system time on
-// 349k faults, and 10.1 s wall became 7.2 s with glibc's malloc asking for huge
-// pages (30k faults; bench/README.md, "Huge pages"). glibc takes that only from
-// the environment at start, so the command sets it and runs itself again.
-// REFIT_NO_HUGE_PAGES=1 opts out; a tool tracing this process (valgrind) would
-// lose it across the exec, so under valgrind nothing is done.
+// Large buffers on transparent huge pages, when REFIT_HUGE_PAGES=1 asks for it.
+// Off by default: on a virtual machine that hands free memory back to its host
+// (virtio-balloon free page reporting, as the machine this project is measured on), free blocks
+// of 2 MB are handed back a few seconds after they are freed, so a huge page is
+// almost always memory the host must fault in again: the dense 1M dress spent
+// 6.4 s of system time with huge pages against 0.8 s without (wall 10.7 against
+// 7.6 s; bench/README.md, "Huge pages off by default"). On a machine whose 4 KB
+// faults are the expensive part they still help (10.1 -> 7.2 s there), which
+// is why the switch stays. glibc takes it only from the environment at start,
+// so the command sets it and runs itself again; a tool tracing this process
+// (valgrind) would lose it across the exec, so under valgrind nothing is done.
 void run_on_huge_pages(char** argv) {
   const char* tunables = std::getenv("GLIBC_TUNABLES");
   if (tunables && std::strstr(tunables, "glibc.malloc.hugetlb")) return;  // set already (by us or the user)
-  if (std::getenv("REFIT_NO_HUGE_PAGES")) return;
+  const char* asked = std::getenv("REFIT_HUGE_PAGES");
+  if (!asked || std::strcmp(asked, "1") != 0) return;
   const char* preload = std::getenv("LD_PRELOAD");
   if (preload && std::strstr(preload, "vgpreload")) return;
   const std::string tunable = refit::cli::kHugePagesTunable;
