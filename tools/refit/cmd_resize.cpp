@@ -355,10 +355,12 @@ int run(ResizeArgs a) {
   if (!a.patterns.dir.empty()) patterns.emplace(garment, features, a.garment, a.features, with_units(a.patterns, a.units));
   const GarmentBinding binding(garment, std::move(body_a), options, std::move(features), progress);
   run.bind_report = binding.bind_report();
+  std::size_t resized = 0;
   const int status = run.bodies(
       [&](const BodyMesh& body_b, const std::string& out) {
         ResizeResult r = binding.resize(body_b, progress);
         Stopwatch write;
+        if (++resized == a.to.size()) release_free_heap();  // the file's pages reuse it (heap.hpp)
         progress.stage("writing " + out);
         ObjWriteReport written = write_garment_obj(out, *garment, r.positions);
         if (patterns) r.report["patterns"] = patterns->write(body_b.name, r.positions, true);

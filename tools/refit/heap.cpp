@@ -52,4 +52,14 @@ void grow_heap_for_run(std::size_t peak_bytes) {
   for (auto it = blocks.rbegin(); it != blocks.rend(); ++it) std::free(*it);
 }
 
+// The output's page cache takes as much fresh memory as the file is long, and the
+// kernel hands out first what was freed a moment ago. On a virtual machine that
+// returns free memory to its host, fresh memory costs about 5 ms per MB more than
+// memory freed within seconds, so the heap's free pages (the collision step's
+// arrays) handed back just before the write serve the file's pages: the 4M
+// dress's write took 6.3-8.4 s, now 0.9 s (bench/README.md, "The heap handed back
+// before the last write"). Only before the last body's write: a body after it
+// would touch its heap afresh.
+void release_free_heap() { malloc_trim(0); }
+
 }  // namespace refit::cli

@@ -19,4 +19,8 @@ void keep_freed_memory();
 /// "The heap grown ahead"). Not for the chunked mode, whose peak it would raise.
 void grow_heap_for_run(std::size_t peak_bytes);
 
+/// The heap's free memory handed back to the system, before the run's last output
+/// is written (see heap.cpp): the file's page cache then reuses it.
+void release_free_heap();
+
 }  // namespace refit::cli
