@@ -36,15 +36,15 @@ namespace {
 
 // Large buffers on transparent huge pages, when REFIT_HUGE_PAGES=1 asks for it.
 // Off by default: on a virtual machine that hands free memory back to its host
-// (virtio-balloon free page reporting, as the machine this project is measured on), free blocks
-// of 2 MB are handed back a few seconds after they are freed, so a huge page is
-// almost always memory the host must fault in again: the dense 1M dress spent
-// 6.4 s of system time with huge pages against 0.8 s without (wall 10.7 against
-// 7.6 s; bench/README.md, "Huge pages off by default"). On a machine whose 4 KB
-// faults are the expensive part they still help (10.1 -> 7.2 s there), which
-// is why the switch stays. glibc takes it only from the environment at start,
-// so the command sets it and runs itself again; a tool tracing this process
-// (valgrind) would lose it across the exec, so under valgrind nothing is done.
+// (virtio-balloon free page reporting, as on the machine this project is measured
+// on), free 2 MB blocks go back a few seconds after they are freed, so a huge
+// page is almost always memory the host must fault in again: the dense 1M dress
+// spent 6.6 s of system time with huge pages against 0.7 s without (wall 11.2
+// against 7.5 s; bench/README.md, "Huge pages off by default"). On a machine
+// whose 4 KB faults are the expensive part they still help (10.1 -> 7.2 s there),
+// which is why the switch stays. glibc takes it only from the environment at
+// start, so the command sets it and runs itself again; a tool tracing this
+// process (valgrind) would lose it across the exec, so under valgrind nothing is done.
 void run_on_huge_pages(char** argv) {
   const char* tunables = std::getenv("GLIBC_TUNABLES");
   if (tunables && std::strstr(tunables, "glibc.malloc.hugetlb")) return;  // set already (by us or the user)
