@@ -60,6 +60,9 @@ struct CollisionOptions {
   /// that resolves one garment on many bodies (on a 1M garment it takes 0.1 s
   /// to make); null: made here.
   const Csr* adjacency = nullptr;
+  /// Optional: the garment's vertex_faces (core/topology.hpp), for the same
+  /// caller; null: made here.
+  const Csr* faces_of_vertex = nullptr;
   /// Optional: where a layer lies over another in the input (bind_layer_order):
   /// each outer point is kept its `keep` over its inner vertex, its triangle's
   /// corners pushed outward (spread as any correction) where the inner layer

@@ -556,6 +556,7 @@ void GarmentBinding::collision_step(const BodySurface& surface_b, bool symmetric
       return moves;
     };
   co.adjacency = &adjacency;
+  co.faces_of_vertex = &folds_once().faces_of_vertex;  // made once, with the folds' binding
   if (!layer_covers_.empty()) co.layers = &layer_covers_;
   const CollisionReport c = resolve_penetrations(*garment_, result.positions, surface_b, co);
   result.report["timings_ms"]["collision"] = clock.ms();
