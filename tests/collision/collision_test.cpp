@@ -1,6 +1,7 @@
 // The collision step: garment vertices and faces inside body B or too close come
 // out, smoothly, locally and for any thread count the same.
 #include <refit/collision/collision.hpp>
+#include <refit/collision/unfold.hpp>
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
 #include <refit/core/topology.hpp>
@@ -456,6 +457,37 @@ TEST(Collision, FarPiecesThatNeverMoveLeaveTheResultAsItIs) {
   EXPECT_TRUE(with.bottomRows(with.rows() - n) == padded.positions.bottomRows(with.rows() - n));
   EXPECT_EQ(r_alone.moved, r_with.moved);
   EXPECT_EQ(r_alone.rounds, r_with.rounds);
+}
+
+// A correction that would turn faces over is evened out over their corners
+// (unfold.hpp). A small region's faces are listed from its vertices, a larger
+// one's from a scan: the same faces either way, so the same correction on a
+// 4 x 4 grid alone (the scan) and with far copies (the list).
+TEST(Collision, UnfoldEvensOutACorrectionThatTurnsFacesOverTheSameForFewOrManyVertices) {
+  const Garment g = test::quad_grid(4, 4, 1.0, [](double, double) { return 0.0; });
+  Garment padded = g;
+  for (int k = 1; k <= 20; ++k) {
+    Garment far = g;
+    far.positions.col(0).array() += 100.0 * k;
+    padded = test::merge_garments(padded, far);
+  }
+  // Vertex 5 (1, 0, 1) pushed past its neighbours at x = 2, vertex 6 (1, 0, 2) a little.
+  const std::vector<Index> region = {5, 6};
+  const auto run = [&](const Garment& garment) {
+    std::vector<long> slot(garment.vertex_count(), -1);
+    slot[5] = 0, slot[6] = 1;
+    std::vector<Vec3> disp = {Vec3(2.5, 0, 0), Vec3(0.5, 0, 0)};
+    unfold(garment, garment.positions, vertex_faces(garment), region, [&](Index v) { return slot[v]; }, 10, disp);
+    return disp;
+  };
+  const std::vector<Vec3> scanned = run(g), listed = run(padded);
+  EXPECT_LT(scanned[0].x(), 1.0);  // evened out, not left at 2.5
+  EXPECT_TRUE(scanned == listed);
+  Points moved = g.positions;
+  moved.row(5) += scanned[0].transpose();
+  moved.row(6) += scanned[1].transpose();
+  for (std::size_t f = 0; f < g.faces.rows(); ++f)
+    EXPECT_GT(face_normal(moved, g.faces.row(f)).dot(face_normal(g.positions, g.faces.row(f))), 0.0) << f;
 }
 
 // Layers: a fine shell too close to the body under a coarse one clear of it.

@@ -709,7 +709,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
       });
       std::swap(disp, next);
     }
-    unfold(g, positions, region, slot_of, options.unfold_passes, disp);
+    unfold(g, positions, faces_of, region, slot_of, options.unfold_passes, disp);
     if (options.pinned)
       for (std::size_t k = 0; k < m; ++k)
         if ((*options.pinned)[region[k]] && !con_at[k]) disp[k] = Vec3::Zero();
