@@ -24,6 +24,22 @@ BodyMesh sphere_body(int levels, double radius) { return test::icosphere(levels,
 
 Garment sphere_garment(int levels, double radius) { return test::icosphere_garment(levels, radius); }
 
+// A flat 5 x 5 grid of 4 cm quads at height y, centred over the origin.
+Garment coarse_grid(double y) {
+  return test::quad_grid(6, 6, 4.0, [y](double, double) { return y; }, -10.0, -10.0);
+}
+
+// g and `copies` copies of it, each 100 further along x: far from any body.
+Garment with_far_copies(const Garment& g, int copies) {
+  Garment out = g;
+  for (int k = 1; k <= copies; ++k) {
+    Garment far = g;
+    far.positions.col(0).array() += 100.0 * k;
+    out = test::merge_garments(out, far);
+  }
+  return out;
+}
+
 // -- penetration resolution -----------------------------------------------------
 
 struct Pushed {
@@ -217,15 +233,7 @@ TEST(Collision, TheBodyPokingThroughACoarseFaceIsPushedOutToo) {
   // corners nearest its top, (+-2, +-2), clear the body by about 0.2 (more than
   // the clearance, 0.1), but the sphere's top pokes through the middle face.
   const BodySurface body(sphere_body(4, 10.0));
-  Garment g;
-  g.positions.resize(36, 3);
-  for (int i = 0; i < 6; ++i)
-    for (int k = 0; k < 6; ++k) g.positions.row(i * 6 + k) << -10.0 + 4.0 * i, 9.8, -10.0 + 4.0 * k;
-  for (int i = 0; i < 5; ++i)
-    for (int k = 0; k < 5; ++k) {
-      const Index a = Index(i * 6 + k);
-      g.faces.push_row(std::array<Index, 4>{a, a + 1, a + 7, a + 6});
-    }
+  const Garment g = coarse_grid(9.8);
   CollisionOptions o;
   o.clearance = 0.1;
   Points out = g.positions;
@@ -429,21 +437,8 @@ TEST(Collision, FarPiecesThatNeverMoveLeaveTheResultAsItIs) {
   // corners nearest its top are too close (0.055 off it, clearance 0.1), so the
   // middle face waits for round 2, where the body pokes through its middle.
   const BodySurface body(sphere_body(4, 10.0));
-  Garment g;
-  g.positions.resize(36, 3);
-  for (int i = 0; i < 6; ++i)
-    for (int k = 0; k < 6; ++k) g.positions.row(i * 6 + k) << -10.0 + 4.0 * i, 9.65, -10.0 + 4.0 * k;
-  for (int i = 0; i < 5; ++i)
-    for (int k = 0; k < 5; ++k) {
-      const Index a = Index(i * 6 + k);
-      g.faces.push_row(std::array<Index, 4>{a, a + 1, a + 7, a + 6});
-    }
-  Garment padded = g;
-  for (int k = 1; k <= 40; ++k) {
-    Garment far = g;
-    far.positions.col(0).array() += 100.0 * k;
-    padded = test::merge_garments(padded, far);
-  }
+  const Garment g = coarse_grid(9.65);
+  const Garment padded = with_far_copies(g, 40);
   CollisionOptions o;
   o.clearance = 0.1;
   const Eigen::Index n = g.positions.rows();
@@ -465,12 +460,7 @@ TEST(Collision, FarPiecesThatNeverMoveLeaveTheResultAsItIs) {
 // 4 x 4 grid alone (the scan) and with far copies (the list).
 TEST(Collision, UnfoldEvensOutACorrectionThatTurnsFacesOverTheSameForFewOrManyVertices) {
   const Garment g = test::quad_grid(4, 4, 1.0, [](double, double) { return 0.0; });
-  Garment padded = g;
-  for (int k = 1; k <= 20; ++k) {
-    Garment far = g;
-    far.positions.col(0).array() += 100.0 * k;
-    padded = test::merge_garments(padded, far);
-  }
+  const Garment padded = with_far_copies(g, 20);
   // Vertex 5 (1, 0, 1) pushed past its neighbours at x = 2, vertex 6 (1, 0, 2) a little.
   const std::vector<Index> region = {5, 6};
   const auto run = [&](const Garment& garment) {
