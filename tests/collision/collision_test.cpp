@@ -467,7 +467,9 @@ TEST(Collision, UnfoldEvensOutACorrectionThatTurnsFacesOverTheSameForFewOrManyVe
     std::vector<long> slot(garment.vertex_count(), -1);
     slot[5] = 0, slot[6] = 1;
     std::vector<Vec3> disp = {Vec3(2.5, 0, 0), Vec3(0.5, 0, 0)};
-    unfold(garment, garment.positions, vertex_faces(garment), region, [&](Index v) { return slot[v]; }, 10, disp);
+    const Csr faces_of_vertex = vertex_faces(garment);
+    unfold(garment, garment.positions, region, [&]() -> const Csr& { return faces_of_vertex; },
+           [&](Index v) { return slot[v]; }, 10, disp);
     return disp;
   };
   const std::vector<Vec3> scanned = run(g), listed = run(padded);

@@ -11,6 +11,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace refit {
 
@@ -370,11 +371,17 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   if (!options.adjacency) own_adjacency = vertex_adjacency(g);
   const Csr& adj = options.adjacency ? *options.adjacency : own_adjacency;
   if (adj.rows() != n) throw Error("penetration resolution: the vertex adjacency does not match the garment");
-  Csr own_faces_of_vertex;
-  if (!options.faces_of_vertex) own_faces_of_vertex = vertex_faces(g);
-  const Csr& faces_of = options.faces_of_vertex ? *options.faces_of_vertex : own_faces_of_vertex;
-  if (faces_of.rows() != n) throw Error("penetration resolution: the vertex faces do not match the garment");
-  std::vector<std::uint8_t> face_listed(g.faces.rows(), 0);
+  if (options.faces_of_vertex && options.faces_of_vertex->rows() != n)
+    throw Error("penetration resolution: the vertex faces do not match the garment");
+  // The faces of each vertex, for the rounds that check few vertices: made here
+  // (once) only when such a round comes and the caller has none.
+  std::optional<Csr> own_faces_of_vertex;
+  const auto faces_of = [&]() -> const Csr& {
+    if (options.faces_of_vertex) return *options.faces_of_vertex;
+    if (!own_faces_of_vertex) own_faces_of_vertex = vertex_faces(g);
+    return *own_faces_of_vertex;
+  };
+  std::vector<std::uint8_t> face_listed;
 
   // Remembers where a vertex started before the step first moves it.
   const auto touch = [&](Index i) {
@@ -453,8 +460,9 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     const bool scan = all || count * 16 > n;
     std::vector<Index> listed;
     if (!scan) {
+      face_listed.resize(nf, 0);
       for (std::size_t k = 0; k < count; ++k)
-        for (Index f : faces_of.row(to_check[k]))
+        for (Index f : faces_of().row(to_check[k]))
           if (!face_listed[f]) face_listed[f] = 1, listed.push_back(f);
       std::sort(listed.begin(), listed.end());
       for (Index f : listed) face_listed[f] = 0;
@@ -709,7 +717,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
       });
       std::swap(disp, next);
     }
-    unfold(g, positions, faces_of, region, slot_of, options.unfold_passes, disp);
+    unfold(g, positions, region, faces_of, slot_of, options.unfold_passes, disp);
     if (options.pinned)
       for (std::size_t k = 0; k < m; ++k)
         if ((*options.pinned)[region[k]] && !con_at[k]) disp[k] = Vec3::Zero();

@@ -61,7 +61,8 @@ struct CollisionOptions {
   /// to make); null: made here.
   const Csr* adjacency = nullptr;
   /// Optional: the garment's vertex_faces (core/topology.hpp), for the same
-  /// caller; null: made here.
+  /// caller: the rounds that check few vertices ask only their faces. Null:
+  /// made here when the first such round needs it.
   const Csr* faces_of_vertex = nullptr;
   /// Optional: where a layer lies over another in the input (bind_layer_order):
   /// each outer point is kept its `keep` over its inner vertex, its triangle's

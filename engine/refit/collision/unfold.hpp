@@ -35,10 +35,10 @@ Vec3 displaced_face_normal(const Garment& g, const Points& positions, std::size_
 // all move alike keeps its normal), for up to `passes` passes. Faces the
 // correction does not reach (no region corner) cannot turn. After the first
 // pass only the faces around a changed corner are tested again: the others
-// keep their verdict. `faces_of_vertex`: vertex_faces(g).
-template <class SlotOf>
-void unfold(const Garment& g, const Points& positions, const Csr& faces_of_vertex, const std::vector<Index>& region,
-            const SlotOf& slot_of, int passes, std::vector<Vec3>& disp) {
+// keep their verdict. `faces_of_vertex()`: vertex_faces(g), asked for a small region only.
+template <class FacesOfVertex, class SlotOf>
+void unfold(const Garment& g, const Points& positions, const std::vector<Index>& region,
+            const FacesOfVertex& faces_of_vertex, const SlotOf& slot_of, int passes, std::vector<Vec3>& disp) {
   // Faces with a corner in the region, ascending: a small region's own (a
   // repair round's tens of vertices of the 1M dress: the scan took 3.5 ms),
   // else from a scan in blocks, each listing its own, joined in order.
@@ -46,7 +46,7 @@ void unfold(const Garment& g, const Points& positions, const Csr& faces_of_verte
   std::vector<Index> faces;
   if (region.size() * 16 <= std::size_t(positions.rows())) {
     for (Index v : region)
-      for (Index f : faces_of_vertex.row(v))
+      for (Index f : faces_of_vertex().row(v))
         if (g.faces.row_size(f) >= 3) faces.push_back(f);
     std::sort(faces.begin(), faces.end());
     faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
