@@ -381,7 +381,6 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     if (!own_faces_of_vertex) own_faces_of_vertex = vertex_faces(g);
     return *own_faces_of_vertex;
   };
-  std::vector<std::uint8_t> face_listed;
 
   // Remembers where a vertex started before the step first moves it.
   const auto touch = [&](Index i) {
@@ -457,16 +456,8 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     // (the same faces in the same order as the scan, which took 8 ms a round on
     // the 1M dress for a few hundred vertices).
     const std::size_t nf = g.faces.rows();
-    const bool scan = all || count * 16 > n;
-    std::vector<Index> listed;
-    if (!scan) {
-      face_listed.resize(nf, 0);
-      for (std::size_t k = 0; k < count; ++k)
-        for (Index f : faces_of().row(to_check[k]))
-          if (!face_listed[f]) face_listed[f] = 1, listed.push_back(f);
-      std::sort(listed.begin(), listed.end());
-      for (Index f : listed) face_listed[f] = 0;
-    }
+    const bool scan = all || !few_vertices(count, n);
+    const std::vector<Index> listed = scan ? std::vector<Index>{} : faces_around(faces_of(), to_check);
     const std::size_t asked = scan ? nf : listed.size();
     std::vector<std::vector<std::pair<Index, Constraint>>> face_found((asked + kBlock - 1) / kBlock);
     std::vector<std::size_t> faces_in(face_found.size(), 0);

@@ -4,12 +4,17 @@
 // over that face's corners until no face turns.
 #include <refit/core/garment.hpp>
 #include <refit/core/parallel.hpp>
+#include <refit/core/topology.hpp>
 
 #include <algorithm>
 #include <cstdint>
 #include <vector>
 
 namespace refit {
+
+// A set of vertices this small against the garment's `total` has its faces
+// listed from the vertices (faces_around) rather than found by a scan of every face.
+inline bool few_vertices(std::size_t count, std::size_t total) { return count * 16 <= total; }
 
 // Newell normal of face f with its region corners displaced by disp.
 template <class SlotOf>
@@ -44,12 +49,9 @@ void unfold(const Garment& g, const Points& positions, const std::vector<Index>&
   // else from a scan in blocks, each listing its own, joined in order.
   const std::size_t nf = g.faces.rows();
   std::vector<Index> faces;
-  if (region.size() * 16 <= std::size_t(positions.rows())) {
-    for (Index v : region)
-      for (Index f : faces_of_vertex().row(v))
-        if (g.faces.row_size(f) >= 3) faces.push_back(f);
-    std::sort(faces.begin(), faces.end());
-    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  if (few_vertices(region.size(), std::size_t(positions.rows()))) {
+    for (Index f : faces_around(faces_of_vertex(), region))
+      if (g.faces.row_size(f) >= 3) faces.push_back(f);
   } else {
     constexpr std::size_t kBlock = 4096;
     std::vector<std::vector<Index>> found((nf + kBlock - 1) / kBlock);

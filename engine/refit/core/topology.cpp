@@ -325,4 +325,12 @@ Csr vertex_faces(const Garment& g) {
   return out;
 }
 
+std::vector<Index> faces_around(const Csr& faces_of_vertex, std::span<const Index> vertices) {
+  std::vector<Index> faces;
+  for (Index v : vertices) faces.insert(faces.end(), faces_of_vertex.row(v).begin(), faces_of_vertex.row(v).end());
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  return faces;
+}
+
 }  // namespace refit

@@ -4,6 +4,7 @@
 #include <refit/core/garment.hpp>
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace refit {
@@ -40,5 +41,9 @@ Csr vertex_adjacency(const Garment& g);
 
 /// Per vertex, the faces it is a corner of (CSR, ascending, each face once).
 Csr vertex_faces(const Garment& g);
+
+/// The faces with a corner among `vertices`, ascending, each once;
+/// `faces_of_vertex`: vertex_faces(g).
+std::vector<Index> faces_around(const Csr& faces_of_vertex, std::span<const Index> vertices);
 
 }  // namespace refit
