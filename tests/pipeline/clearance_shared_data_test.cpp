@@ -126,8 +126,9 @@ TEST(ClearanceSharedData, NoFaceOfTheDressesHasBodyPokingThroughOnBodiesBeyondTh
                                  std::string(c.garment) == "dress_soup" ? std::vector<FeatureSpec>{} : read_feature_file(feature_file));
     const ResizeResult r = binding.resize(body_b);
     const std::size_t before = faces_inside(*garment, r.warped, parity), after = faces_inside(*garment, r.positions, parity);
-    std::printf("[ info ] %s -> %s: %zu faces with a point inside body B after the warp, %zu written\n", c.garment, c.body,
-                before, after);
+    const int inside_rounds = r.report.at("collision").at("inside_rounds").get<int>();
+    std::printf("[ info ] %s -> %s: %zu faces with a point inside body B after the warp, %zu written (%d rounds over "
+                "what was left inside)\n", c.garment, c.body, before, after, inside_rounds);
     EXPECT_GT(before, 100u) << c.garment << " -> " << c.body << ": the warp leaves faces inside";
     EXPECT_EQ(after, 0u) << c.garment << " -> " << c.body;
     EXPECT_EQ(r.report.at("collision").at("faces_inside_after").get<std::size_t>(), 0u) << c.garment;

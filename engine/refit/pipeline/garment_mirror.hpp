@@ -23,6 +23,12 @@ class GarmentMirror {
                 const Points& body_a);
 
   bool active() const { return !body_pairs_.empty(); }
+  /// The garment's layers (`vertex_layer`, per vertex: SurfaceBinding::vertex_layers):
+  /// alike_pushes() then leaves each vertex whose image lies on another layer
+  /// than its own as it is.
+  void set_layers(const std::vector<std::uint32_t>& vertex_layer);
+  /// How many paired vertices alike_pushes() leaves as they are (set_layers).
+  std::size_t pushed_apart() const { return pushed_apart_; }
   double plane_x() const { return plane_x_; }
   /// Largest distance between a body B vertex and its partner's mirror image
   /// (body B has body A's vertices), and whether that is within the tolerance.
@@ -40,15 +46,18 @@ class GarmentMirror {
  private:
   /// Vertex i's mirror image's move (carried on the garment's faces) from `before` to `after`, mirrored.
   Vec3 mirrored_move(const Points& before, const Points& after, Index i) const;
-  /// The paired vertices whose own move from `before` to `after` or whose image's may
+  /// The vertices of `paired` (paired_ or pushed_alike_) whose own move from `before` to `after` or whose image's may
   /// not be zero (it or a corner of its image's face moved), with `row(i)` of each,
   /// in vertex order: a collision step or a snap moves a few of a million vertices.
   template <class Row>
-  std::vector<std::pair<Index, Vec3>> paired_moving_rows(const Points& before, const Points& after, const Row& row) const;
+  std::vector<std::pair<Index, Vec3>> paired_moving_rows(const Points& before, const Points& after, const Row& row,
+                                                         const std::vector<std::uint8_t>& paired) const;
 
   double plane_x_ = 0.0, tolerance_ = 0.0;
   SurfaceAttachment images_;          // per garment vertex, its mirror image on the garment's surface
   std::vector<std::uint8_t> paired_;  // ... when that image is within the tolerance
+  std::vector<std::uint8_t> pushed_alike_;  // ... and on the vertex's own layer (set_layers; empty: as paired_)
+  std::size_t pushed_apart_ = 0;
   std::vector<Index> body_pairs_;     // per body A vertex, its mirror partner (or kNoMirror)
 };
 

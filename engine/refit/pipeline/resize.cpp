@@ -213,6 +213,7 @@ GarmentBinding::GarmentBinding(std::shared_ptr<const Garment> garment, BodyMesh 
       throw input_error(garment_->source ? garment_->source->file : "garment", e.what());
     }
     bind_report_["surface"] = clock.ms();
+    if (mirror_.active() && options_.collision) mirror_.set_layers(surface_->vertex_layers());
     // Which layer lies over which, for the collision step to keep them so.
     if (options_.collision && surface_->vertex_layers().size() == garment_->vertex_count()) {
       clock.reset();
@@ -561,6 +562,7 @@ void GarmentBinding::collision_step(const BodySurface& surface_b, bool symmetric
   const CollisionReport c = resolve_penetrations(*garment_, result.positions, surface_b, co);
   result.report["timings_ms"]["collision"] = clock.ms();
   result.report["collision"] = c.to_json();
+  if (symmetric_b) result.report["collision"]["not_pushed_alike"] = mirror_.pushed_apart();  // images on another layer
   if (options_.smooth_folds) {
     auto figures = [](const FoldReport& f) {
       return nlohmann::json{{"folded", f.folded_before}, {"left", f.folded_after}, {"smoothed", f.smoothed}, {"rounds", f.rounds}};
