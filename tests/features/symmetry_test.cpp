@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <cmath>
 
 using namespace refit;
@@ -131,6 +133,26 @@ TEST(Symmetry, SymmetriseMakesPairedRowsMirrorImages) {
   Points kept = original;
   symmetrise(kept, none, 1.0);
   EXPECT_EQ(kept, original);
+}
+
+// A vertex whose mirror image lies a little beyond the tolerance goes part of
+// the way to the mean with it: the share falls smoothly from 1 at the tolerance
+// to 0 at twice it, so the line where a garment's own asymmetry crosses the
+// tolerance is no step.
+TEST(Symmetry, TheSymmetrisedShareEasesFromTheToleranceToTwiceIt) {
+  EXPECT_EQ(symmetrised_share(0.0, 1.0), 1.0);
+  EXPECT_EQ(symmetrised_share(1.0, 1.0), 1.0);
+  EXPECT_EQ(symmetrised_share(2.0, 1.0), 0.0);
+  EXPECT_EQ(symmetrised_share(std::numeric_limits<double>::infinity(), 1.0), 0.0);
+  EXPECT_NEAR(symmetrised_share(1.5, 1.0), 0.5, 1e-12);
+  EXPECT_NEAR(symmetrised_share(0.75, 0.5), 0.5, 1e-12);  // scales with the tolerance
+  double last = 1.0;
+  for (double d = 1.0; d <= 2.0; d += 0.01) {  // falls, and no step anywhere
+    const double share = symmetrised_share(d, 1.0);
+    EXPECT_LE(share, last);
+    EXPECT_LT(last - share, 0.02) << d;
+    last = share;
+  }
 }
 
 // The gaps of the skirt's curves before and after the snap after the

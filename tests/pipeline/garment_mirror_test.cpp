@@ -73,5 +73,26 @@ TEST(GarmentMirror, TheSymmetrisationStillUsesAnImageOnAnotherLayer) {
   EXPECT_NEAR(symmetrised(0, 2) - positions(0, 2), 0.2, 1e-12);
 }
 
+// A vertex whose image lies 1.5 times the tolerance off the garment moves half
+// as far to the mean as a paired one; at twice the tolerance, not at all.
+TEST(GarmentMirror, TheSymmetrisationEasesOffBeyondTheTolerance) {
+  for (const double off : {0.0, 1.5, 2.0}) {
+    SCOPED_TRACE(off);
+    Points positions(2, 3);
+    positions << -1, 0, 0, 1, 0, 0;
+    SurfaceAttachment images;
+    images.vertex = {{1, 1, 1}, {0, 0, 0}};
+    images.weight = {{1.0, 0.0, 0.0}, {1.0, 0.0, 0.0}};
+    images.offset.setZero(2, 3);
+    images.offset(0, 2) = off;  // vertex 0's image stands `off` in front of vertex 1
+    const GarmentMirror mirror(0.0, 1.0, std::move(images), {off, 0.0}, positions);
+    Points moved = positions;
+    moved(1, 1) += 0.4;  // vertex 1 rises; vertex 0 stays
+    mirror.symmetrise(moved);
+    const double expected = off <= 1.0 ? 0.2 : off < 2.0 ? 0.1 : 0.0;  // half the way at 1.5 times the tolerance
+    EXPECT_NEAR(moved(0, 1), expected, 1e-12);
+  }
+}
+
 }  // namespace
 }  // namespace refit

@@ -409,15 +409,19 @@ Points symmetrised_rows(const RecordFile<MirrorRecord>& mirror, const PointGathe
                         const Points& s, double plane_x, double tolerance) {
   std::vector<MirrorRecord> rec;
   mirror.read(first, std::size_t(s.rows()), rec);
-  const Points image = images(rec, positions, tolerance);
+  const Points image = images(rec, positions, 2.0 * tolerance);  // symmetrised_share's reach
   Points out = s;
   for (std::size_t i = 0; i < rec.size(); ++i) {
-    if (!(rec[i].distance() <= tolerance)) continue;
+    const double share = symmetrised_share(rec[i].distance(), tolerance);
+    if (!(share > 0.0)) continue;
     // carry_one's sum, then mirror_x.
     const auto r = Eigen::Index(i);
     Eigen::RowVector3d mirrored = image.row(r);
     mirrored(0) = (2.0 * plane_x) - image(r, 0);
-    out.row(r) = 0.5 * (s.row(r) + mirrored);
+    if (rec[i].distance() <= tolerance)
+      out.row(r) = 0.5 * (s.row(r) + mirrored);
+    else
+      out.row(r) += (0.5 * share) * (mirrored - s.row(r));
   }
   return out;
 }

@@ -43,6 +43,14 @@ std::size_t symmetry_percentile_rank(std::size_t count);
 /// p mirrored about x = c.
 Points mirror_x(const Points& p, double c);
 
+/// How much of its way to the mean with its mirror image a vertex goes when the
+/// garment is symmetrised, by the distance of that image to the garment's
+/// surface: all of it within `tolerance`, none beyond twice that, eased
+/// (smoothstep) between. All or nothing, the line where a garment's own
+/// asymmetry crossed the tolerance was a crease (the dense 1M dress's top, whose
+/// front stands up to 1.2 cm farther out on one side).
+double symmetrised_share(double image_distance, double tolerance);
+
 /// `curves` plus, for each curve whose mirror about x = c is not within
 /// `coincide` spacings of an existing curve (itself included), its mirrored
 /// copy named "<name>~mirror" (appended after all given curves, in their order).

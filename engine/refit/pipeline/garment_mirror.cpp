@@ -41,11 +41,18 @@ std::pair<double, bool> GarmentMirror::body_error(const Points& body_b) const {
   return {error, error <= tolerance_};
 }
 
-// A symmetric pair gives a symmetric garment: each paired vertex halfway to its partner's mirror image.
+// A symmetric pair gives a symmetric garment: each paired vertex halfway to its partner's mirror image
+// (symmetrised_share: part of the way for images a little beyond the tolerance).
 void GarmentMirror::symmetrise(Points& positions) const {
   const Points mirrored = mirror_x(carry(images_, positions), plane_x_);
-  for (Index i = 0; i < positions.rows(); ++i)
-    if (paired_[i]) positions.row(i) = 0.5 * (positions.row(i) + mirrored.row(i));
+  for (Index i = 0; i < positions.rows(); ++i) {
+    if (paired_[i]) {
+      positions.row(i) = 0.5 * (positions.row(i) + mirrored.row(i));
+      continue;
+    }
+    const double share = symmetrised_share(images_.offset.row(i).norm(), tolerance_);  // beyond the tolerance: eased
+    if (share > 0.0) positions.row(i) += (0.5 * share) * (mirrored.row(i) - positions.row(i));
+  }
 }
 
 Vec3 GarmentMirror::mirrored_move(const Points& before, const Points& after, Index i) const {
