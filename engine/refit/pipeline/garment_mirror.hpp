@@ -34,7 +34,8 @@ class GarmentMirror {
   /// (body B has body A's vertices), and whether that is within the tolerance.
   std::pair<double, bool> body_error(const Points& body_b) const;
 
-  /// Each paired vertex halfway to its partner's mirror image (its image carried on `positions`).
+  /// Each paired vertex halfway to its partner's mirror image (its image carried on `positions`);
+  /// a vertex whose image lies a little beyond the tolerance part of the way (symmetrised_share).
   void symmetrise(Points& positions) const;
   /// Each paired vertex's move from `before` to `positions` becomes the mean of its own and its image's, mirrored.
   void symmetrise_moves(const Points& before, Points& positions) const;
