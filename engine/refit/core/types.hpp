@@ -65,4 +65,7 @@ struct Csr {
 
 inline Vec3 row3(const Points& p, Index i) { return p.row(i).transpose(); }
 
+/// The smooth step 3t^2 - 2t^3 of t in [0, 1]: an ease with no kink at either end.
+inline double smoothstep(double t) { return t * t * (3.0 - 2.0 * t); }
+
 }  // namespace refit

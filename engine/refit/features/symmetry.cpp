@@ -50,7 +50,7 @@ double symmetrised_share(double image_distance, double tolerance) {
   if (image_distance <= tolerance) return 1.0;
   if (!(image_distance < 2.0 * tolerance)) return 0.0;
   const double t = 2.0 - image_distance / tolerance;  // 1 at the tolerance, 0 at twice it
-  return t * t * (3.0 - 2.0 * t);
+  return smoothstep(t);
 }
 
 Points mirror_x(const Points& p, double c) {

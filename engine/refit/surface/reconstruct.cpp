@@ -228,7 +228,7 @@ std::vector<float> SurfaceBinding::keep_near_vertices(const AgentSolution& sol, 
       if (!near_feature_[blends.reach.indices[j]]) outside += blends.weight[j];
     if (outside >= 0.5 + blend - 1e-6) return 1.0;  // the weights' float sum: all outside is all
     const double t = std::clamp((outside - (0.5 - blend)) / (2.0 * blend), 0.0, 1.0);
-    return t * t * (3.0 - 2.0 * t);
+    return smoothstep(t);
   };
   // How much of the agents' solution v keeps beside the features (feature_slide_rings): its blend's share of it.
   const auto slide_share = [&](std::size_t v) {

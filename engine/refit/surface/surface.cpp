@@ -321,7 +321,7 @@ SurfaceBinding::AgentSolution SurfaceBinding::solve_agents(Points before_in, con
       }
       if (sol.slide.empty()) sol.slide.assign(n, 0.0f);
       const double t = double(rings + 1 - depth[a]) / double(rings);
-      sol.slide[a] = float(t * t * (3.0 - 2.0 * t));
+      sol.slide[a] = float(smoothstep(t));
       banded[a] = 1;
       near[a] = 0;
       ceiling[a] = std::max(body_distance[a], options_.clearance);
