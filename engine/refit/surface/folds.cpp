@@ -305,6 +305,7 @@ FoldReport smooth_out_folds(const Garment& g, const FoldBinding& binding, Points
   // folds through the five rounds; 103 now.)
   std::vector<Index> region;  // every round's, joined
   std::vector<std::uint32_t> reached(nv, 0);  // the last round whose rings reached a vertex
+  constexpr std::uint32_t kFeathered = std::numeric_limits<std::uint32_t>::max();  // in this round's feather
   while (!folded.empty() && rep.rounds < options.max_rounds) {
     ++rep.rounds;
     const auto round = std::uint32_t(rep.rounds);
@@ -326,45 +327,82 @@ FoldReport smooth_out_folds(const Garment& g, const FoldBinding& binding, Points
     std::vector<Index> free;
     for (Index v : region)
       if (!(pinned && (*pinned)[v]) && adjacency.row_size(v) > 0) free.push_back(v);
-    // The passes read the free vertices and their neighbours from compact
-    // copies (slot k < free.size(): free[k]; then the held neighbours): a
-    // neighbour is one or two cache lines, not six of the column arrays (the
-    // 1M dress on F_thinner: 10 passes over 207k vertices a round).
-    std::vector<Index> local(free.begin(), free.end());
-    for (std::size_t k = 0; k < free.size(); ++k) slot[free[k]] = Index(k);
-    std::vector<std::size_t> first(free.size() + 1, 0);
-    for (std::size_t k = 0; k < free.size(); ++k) {
-      first[k + 1] = first[k] + adjacency.row_size(free[k]);
-      for (Index w : adjacency.row(free[k]))
-        if (slot[w] == kNoSlot) slot[w] = Index(local.size()), local.push_back(w);
-    }
-    std::vector<Index> near(first.back());
-    std::vector<Vec3> now(local.size()), from(local.size()), next(free.size());
-    parallel_for(0, local.size(), 1024, [&](std::size_t b, std::size_t e) {
-      for (std::size_t k = b; k < e; ++k) now[k] = row3(positions, local[k]), from[k] = row3(original, local[k]);
-    });
-    parallel_for(0, free.size(), 1024, [&](std::size_t b, std::size_t e) {
-      for (std::size_t k = b; k < e; ++k) {
-        std::size_t at = first[k];
-        for (Index w : adjacency.row(free[k])) near[at++] = slot[w];
+    // The feather: `feather` rings beyond the region, which take their
+    // neighbours' mean move (not their mean displacement from the original:
+    // their shape is kept), so the region's move eases off over them. With the
+    // region's edge held instead, the move stopped within an edge there: on the
+    // 1M dress on F_thinner the regions around the warp's crumples at the waist
+    // are bands a few edges wide, and their edges showed as vertical pleats.
+    std::vector<Index> band;
+    {
+      std::vector<Index> edge(region.begin(), region.end());
+      for (int r = 0; r < options.feather; ++r) {
+        std::vector<Index> next_ring;
+        for (Index v : edge)
+          for (Index w : adjacency.row(v))
+            if (!in[w] && reached[w] != kFeathered) reached[w] = kFeathered, next_ring.push_back(w);
+        band.insert(band.end(), next_ring.begin(), next_ring.end());
+        edge.swap(next_ring);
       }
-    });
-    for (Index v : local) slot[v] = kNoSlot;
-    const std::vector<Vec3> kept(now.begin(), now.begin() + std::ptrdiff_t(free.size()));
-    for (int pass = 0; pass < options.passes; ++pass) {
-      parallel_for(0, free.size(), 1024, [&](std::size_t b, std::size_t e) {
+      for (Index v : band) reached[v] = 0;  // before the rounds' marks again: 0 is no round's
+      std::erase_if(band, [&](Index v) { return (pinned && (*pinned)[v]) || adjacency.row_size(v) == 0; });
+      std::sort(band.begin(), band.end());
+    }
+    // One smoothing of `moving` (its first `eased_from` the region, the rest
+    // the feather), kept when it leaves fewer folds.
+    const auto smooth = [&](const std::vector<Index>& moving, std::size_t eased_from) {
+      // The passes read the moving vertices and their neighbours from compact
+      // copies (slot k < moving.size(): moving[k]; then the held neighbours): a
+      // neighbour is one or two cache lines, not six of the column arrays (the
+      // 1M dress on F_thinner: 10 passes over 207k vertices a round).
+      std::vector<Index> local(moving.begin(), moving.end());
+      for (std::size_t k = 0; k < moving.size(); ++k) slot[moving[k]] = Index(k);
+      std::vector<std::size_t> first(moving.size() + 1, 0);
+      for (std::size_t k = 0; k < moving.size(); ++k) {
+        first[k + 1] = first[k] + adjacency.row_size(moving[k]);
+        for (Index w : adjacency.row(moving[k]))
+          if (slot[w] == kNoSlot) slot[w] = Index(local.size()), local.push_back(w);
+      }
+      std::vector<Index> near(first.back());
+      std::vector<Vec3> now(local.size()), from(local.size()), start(local.size()), next(moving.size());
+      parallel_for(0, local.size(), 1024, [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k)
+          now[k] = start[k] = row3(positions, local[k]), from[k] = row3(original, local[k]);
+      });
+      parallel_for(0, moving.size(), 1024, [&](std::size_t b, std::size_t e) {
         for (std::size_t k = b; k < e; ++k) {
-          Vec3 sum = Vec3::Zero();
-          for (std::size_t j = first[k]; j < first[k + 1]; ++j) sum += now[near[j]] - from[near[j]];
-          next[k] = from[k] + sum / double(first[k + 1] - first[k]);
+          std::size_t at = first[k];
+          for (Index w : adjacency.row(moving[k])) near[at++] = slot[w];
         }
       });
-      std::copy(next.begin(), next.end(), now.begin());
-    }
-    parallel_for(0, free.size(), 1024, [&](std::size_t b, std::size_t e) {
-      for (std::size_t k = b; k < e; ++k) positions.row(free[k]) = now[k].transpose();
-    });
-    if (!keep_if_fewer(o, positions, free, kept, is_folded, folded, turned_at)) break;
+      for (Index v : local) slot[v] = kNoSlot;
+      const std::vector<Vec3> kept(now.begin(), now.begin() + std::ptrdiff_t(moving.size()));
+      for (int pass = 0; pass < options.passes; ++pass) {
+        parallel_for(0, moving.size(), 1024, [&](std::size_t b, std::size_t e) {
+          for (std::size_t k = b; k < e; ++k) {
+            // The region: its neighbours' mean displacement from the original; the feather: their mean move.
+            const std::vector<Vec3>& base = k < eased_from ? from : start;
+            Vec3 sum = Vec3::Zero();
+            for (std::size_t j = first[k]; j < first[k + 1]; ++j) sum += now[near[j]] - base[near[j]];
+            next[k] = base[k] + sum / double(first[k + 1] - first[k]);
+          }
+        });
+        std::copy(next.begin(), next.end(), now.begin());
+      }
+      parallel_for(0, moving.size(), 1024, [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) positions.row(moving[k]) = now[k].transpose();
+      });
+      return keep_if_fewer(o, positions, moving, kept, is_folded, folded, turned_at);
+    };
+    // Where the region's move is large at its edge (a patch shifted several
+    // edges), easing it off over a few rings can turn faces there over: that
+    // round is smoothed again with the edge held.
+    std::vector<Index> eased = free;
+    eased.insert(eased.end(), band.begin(), band.end());
+    bool kept_round = smooth(eased, free.size());
+    if (kept_round) free = std::move(eased);
+    else if (!band.empty()) kept_round = smooth(free, free.size());
+    if (!kept_round) break;
     for (Index v : free) moved[v] = 1;
   }
   for (Index v : reshape_leaning(binding, o, positions, pinned, options.reshape_rounds)) moved[v] = 1;

@@ -16,6 +16,7 @@ namespace refit {
 struct FoldOptions {
   int rings = 2;       // the smoothed region: the folded faces' corners and this many rings around them (times the round)
   int passes = 10;     // Jacobi passes of the smoothing per round
+  int feather = 3;     // rings beyond the region whose move eases its edge (0: the edge held as it is)
   int max_rounds = 5;  // re-detect and smooth again (the region grown around what is left) while folds are left
   int reshape_rounds = 5;  // then faces leaning over 60 degrees take their original shape, turned as around (folds.cpp)
 };
@@ -44,10 +45,12 @@ FoldBinding bind_folds(const Garment& g);
 
 /// Smooths out the faces folded in `positions` (agreeing on the original, not
 /// now): their corners and `rings` rings around them take their neighbours' mean
-/// displacement from the original (Jacobi passes, the region's edge held: a
-/// smooth stretch or turn is kept, a crumple is not), pinned vertices excepted
-/// (per vertex, or null). A round that leaves no fewer folds is undone and ends
-/// the smoothing (the detector misreads some small details). Then the faces
+/// displacement from the original (Jacobi passes: a smooth stretch or turn is
+/// kept, a crumple is not), and `feather` rings beyond them their neighbours'
+/// mean move (the region's move eased off; the vertices beyond held), pinned
+/// vertices excepted (per vertex, or null). A round that leaves no fewer folds
+/// is tried again with the region's edge held, then undone, and ends the
+/// smoothing (the detector misreads some small details). Then the faces
 /// still leaning more than 60 degrees off their corners (slivers of a split
 /// mesh, which smoothing cannot even out that finely) take their original shape
 /// turned as their neighbourhood turned (folds.cpp). Folds are counted with the
