@@ -366,6 +366,17 @@ def face_pairs(faces):
     return np.asarray([v for v in edges.values() if len(v) == 2], dtype=np.int64).reshape(-1, 2)
 
 
+def welded_face_pairs(positions, faces):
+    """Coincident vertices welded (weld_ids: a soup's faces meet along their edges),
+    the faces on the welded vertices and their face_pairs: the edges creases are
+    counted on. Returns (ids, welded faces, pairs)."""
+    ids = weld_ids(positions)
+    rep = np.empty(ids.max() + 1, dtype=np.int64)
+    rep[ids] = np.arange(len(ids))
+    welded = [[int(rep[ids[v]]) for v in f] for f in faces]
+    return ids, welded, np.asarray(face_pairs(welded))
+
+
 def dihedral_change(original, result, faces, pairs=None):
     """Per edge of face_pairs(faces) (or the `pairs` given, made by it once for
     several results), the change of the angle between its two faces' normals from

@@ -298,13 +298,8 @@ def run_blender(case, out_dir):
 
 def evaluate(args, case, out_dir):
     original, faces = meshes.read_obj(case.garment_path)
-    ids = meshes.weld_ids(original)
-    # The faces on welded vertices (a soup's faces meet along their edges) and
-    # their edges, for the creases of every method's result.
-    rep = np.empty(ids.max() + 1, dtype=np.int64)
-    rep[ids] = np.arange(len(ids))
-    welded = [[int(rep[ids[v]]) for v in f] for f in faces]
-    pairs = np.asarray(meshes.face_pairs(welded))
+    # The faces on welded vertices and their edges, for the creases of every method's result.
+    ids, welded, pairs = meshes.welded_face_pairs(original, faces)
     body_a = meshes.Body(case.a_path)
     body_b = meshes.Body(case.b_path)
     dist_a = body_a.signed_distance(original)
