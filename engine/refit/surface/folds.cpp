@@ -377,14 +377,27 @@ FoldReport smooth_out_folds(const Garment& g, const FoldBinding& binding, Points
       });
       for (Index v : local) slot[v] = kNoSlot;
       const std::vector<Vec3> kept(now.begin(), now.begin() + std::ptrdiff_t(moving.size()));
+      // A vertex takes base + mean(now - base) over its neighbours, base the
+      // original for the region (their mean displacement) and the start for the
+      // feather (their mean move). The neighbours' base sum does not change between
+      // passes, so a pass reads only their positions: half the gathers of the
+      // passes that are most of the smoothing's time.
+      std::vector<Vec3> base_less_mean(moving.size());
+      parallel_for(0, moving.size(), 1024, [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) {
+          const std::vector<Vec3>& base = k < eased_from ? from : start;
+          Vec3 sum = Vec3::Zero();
+          for (std::size_t j = first[k]; j < first[k + 1]; ++j) sum += base[near[j]];
+          const double n = double(first[k + 1] - first[k]);
+          base_less_mean[k] = base[k] - sum / n;
+        }
+      });
       for (int pass = 0; pass < options.passes; ++pass) {
         parallel_for(0, moving.size(), 1024, [&](std::size_t b, std::size_t e) {
           for (std::size_t k = b; k < e; ++k) {
-            // The region: its neighbours' mean displacement from the original; the feather: their mean move.
-            const std::vector<Vec3>& base = k < eased_from ? from : start;
             Vec3 sum = Vec3::Zero();
-            for (std::size_t j = first[k]; j < first[k + 1]; ++j) sum += now[near[j]] - base[near[j]];
-            next[k] = base[k] + sum / double(first[k + 1] - first[k]);
+            for (std::size_t j = first[k]; j < first[k + 1]; ++j) sum += now[near[j]];
+            next[k] = base_less_mean[k] + sum / double(first[k + 1] - first[k]);
           }
         });
         std::copy(next.begin(), next.end(), now.begin());
