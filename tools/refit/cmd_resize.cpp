@@ -1,7 +1,6 @@
 // `refit resize`: one garment, body A, one or many bodies B. Binds once, then
 // resizes to each body; every output file is written atomically.
 #include "command.hpp"
-#include "heap.hpp"
 #include "manifest.hpp"
 #include "patterns_output.hpp"
 #include "report_file.hpp"
@@ -9,6 +8,7 @@
 #include <refit/chunked/chunked_resize.hpp>
 #include <refit/chunked/garment_store.hpp>
 #include <refit/core/error.hpp>
+#include <refit/core/heap.hpp>
 #include <refit/core/parallel.hpp>
 #include <refit/io/atomic_file.hpp>
 #include <refit/io/body_io.hpp>
@@ -341,7 +341,7 @@ int run(ResizeArgs a) {
                               garment->positions.colwise().maxCoeff().transpose(), a.garment, body_a, units_per_cm(a.units));
   }
   run.load_ms = clock.ms();
-  // The heap grown to the run's estimated peak at once, on every thread (heap.hpp).
+  // The heap grown to the run's estimated peak at once, on every thread (refit/core/heap.hpp).
   // The estimate is the whole pipeline's: a run that stops short of the collision
   // step peaks far below it (the 1M dress's warp alone: 286 MB against 645).
   if (options.stage == Stage::Full && options.collision)
@@ -360,7 +360,7 @@ int run(ResizeArgs a) {
       [&](const BodyMesh& body_b, const std::string& out) {
         ResizeResult r = binding.resize(body_b, progress);
         Stopwatch write;
-        if (++resized == a.to.size()) release_free_heap();  // the file's pages reuse it (heap.hpp)
+        if (++resized == a.to.size()) release_free_heap();  // the file's pages reuse it (refit/core/heap.hpp)
         progress.stage("writing " + out);
         ObjWriteReport written = write_garment_obj(out, *garment, r.positions);
         if (patterns) r.report["patterns"] = patterns->write(body_b.name, r.positions, true);

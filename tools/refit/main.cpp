@@ -1,9 +1,9 @@
 // `refit`: the command line. Every error reaches the user as one line on stderr
 // and a non-zero exit; commands write their outputs atomically.
 #include "command.hpp"
-#include "heap.hpp"
 
 #include <refit/core/error.hpp>
+#include <refit/core/heap.hpp>
 #include <refit/io/atomic_file.hpp>
 
 #include <unistd.h>
@@ -64,7 +64,7 @@ void run_on_huge_pages(char** argv) {
 
 int main(int argc, char** argv) {
   run_on_huge_pages(argv);
-  refit::cli::keep_freed_memory();
+  refit::keep_freed_memory();
   using namespace refit::cli;
   CLI::App app{"refit: resize 3D garments to new bodies while keeping their designed shape"};
   app.require_subcommand(1);

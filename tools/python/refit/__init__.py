@@ -17,6 +17,10 @@ command line's exit class: InputError (bad input, 1), UsageError (an argument
 value it refuses, 2; also a ValueError), ResourceError (out of memory, 3; also a
 MemoryError). `exit_code` holds the number.
 
+A process that resizes many large garments (a server, a batch worker) calls
+refit.keep_freed_memory() once at start: freed buffers are then reused, as the
+command line does.
+
 refit.batch (the `refit-batch` command): one garment to the bodies of a manifest
 on a Dask cluster. docs/python.md has the details.
 """
@@ -32,6 +36,7 @@ from ._refit import (
     UsageError,
     __version__,
     compare,
+    keep_freed_memory,
     read_body,
     read_features,
     read_garment,
@@ -50,6 +55,7 @@ __all__ = [
     "Result",
     "UsageError",
     "compare",
+    "keep_freed_memory",
     "read_body",
     "read_features",
     "read_garment",

@@ -1,13 +1,17 @@
 #pragma once
-// The command's memory policy: how its heap grows and is reused. Only the
-// command sets it; the library leaves a host program's allocator alone.
+// An opt-in memory policy for a process that resizes large garments: how
+// glibc's heap grows and is reused. The library never sets it by itself (it
+// leaves a host program's allocator alone); the command line sets it at start,
+// and a host such as the Python module or its batch workers may opt in.
 #include <cstddef>
 
-namespace refit::cli {
+namespace refit {
 
 /// Freed buffers kept for the next ones instead of handed back to the system
-/// (see heap.cpp). Call once, before anything large is allocated.
-void keep_freed_memory();
+/// (see heap.cpp), for the whole process. Call once, before anything large is
+/// allocated. Returns false where it does nothing (an allocator other than
+/// glibc's, such as a sanitizer's).
+bool keep_freed_memory();
 
 /// For a garment resized in memory by the whole pipeline, whose peak is
 /// estimated at `peak_bytes` (a run's true peak, not a bound far above it):
@@ -23,4 +27,4 @@ void grow_heap_for_run(std::size_t peak_bytes);
 /// is written (see heap.cpp): the file's page cache then reuses it.
 void release_free_heap();
 
-}  // namespace refit::cli
+}  // namespace refit

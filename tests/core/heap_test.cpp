@@ -1,6 +1,6 @@
-// The command's heap policy (tools/refit/heap.hpp): a large in-memory run grows
+// The opt-in heap policy (refit/core/heap.hpp): a large in-memory run grows
 // the heap to its estimated peak at once, and the run then reuses that memory.
-#include "refit/heap.hpp"
+#include <refit/core/heap.hpp>
 
 #include <gtest/gtest.h>
 
@@ -27,9 +27,9 @@ TEST(Heap, ALargeRunsPeakIsHeldByTheHeapAheadAndReused) {
   GTEST_SKIP() << "the address sanitizer's allocator replaces glibc's heap";
 #else
   constexpr std::size_t kMb = std::size_t(1) << 20;
-  cli::keep_freed_memory();
+  EXPECT_TRUE(keep_freed_memory());
   const struct mallinfo2 before = mallinfo2();
-  cli::grow_heap_for_run(before.uordblks + 400 * kMb);
+  grow_heap_for_run(before.uordblks + 400 * kMb);
   const struct mallinfo2 grown = mallinfo2();
   EXPECT_GE(grown.arena + grown.hblkhd, before.arena + 380 * kMb) << "the heap holds the run's estimate";
   EXPECT_LT(grown.uordblks, before.uordblks + kMb) << "everything it took is free again (the threads keep a few KB)";
@@ -56,8 +56,8 @@ TEST(Heap, AFreedTopAboveTwoGigabytesStaysInTheHeap) {
   GTEST_SKIP() << "the address sanitizer's allocator replaces glibc's heap";
 #else
   constexpr std::size_t kMb = std::size_t(1) << 20;
-  cli::keep_freed_memory();
-  cli::grow_heap_for_run(0);  // every block from the heap (and nothing grown ahead: too small to be worth it)
+  EXPECT_TRUE(keep_freed_memory());
+  grow_heap_for_run(0);  // every block from the heap (and nothing grown ahead: too small to be worth it)
   char* block = static_cast<char*>(std::malloc(2300 * kMb));
   if (!block) GTEST_SKIP() << "no 2.3 GB of address space here (ulimit -v, or no overcommit)";
   const struct mallinfo2 held = mallinfo2();

@@ -1,4 +1,4 @@
-#include "heap.hpp"
+#include <refit/core/heap.hpp>
 
 #include <refit/core/parallel.hpp>
 
@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <vector>
 
-namespace refit::cli {
+namespace refit {
 
 // glibc maps every block above its mmap threshold (128 KB, rising with use) on
 // its own and unmaps it on free, and trims the heap's top, so each stage's
@@ -19,9 +19,11 @@ namespace refit::cli {
 // threshold (INT_MAX) still trimmed a free top above 2 GB, so a 4M garment's
 // heap grown ahead for the run was handed back at once and touched again
 // (bench/README.md, "A heap above 2 GB was handed back").
-void keep_freed_memory() {
-  mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024);
-  mallopt(M_TRIM_THRESHOLD, -1);
+bool keep_freed_memory() {
+  // mallopt returns 1 on success (0 from an allocator that takes no such settings).
+  const bool threshold = mallopt(M_MMAP_THRESHOLD, 32 * 1024 * 1024) == 1;
+  const bool trim = mallopt(M_TRIM_THRESHOLD, -1) == 1;
+  return threshold && trim;
 }
 
 void grow_heap_for_run(std::size_t peak_bytes) {
@@ -62,4 +64,4 @@ void grow_heap_for_run(std::size_t peak_bytes) {
 // would touch its heap afresh.
 void release_free_heap() { malloc_trim(0); }
 
-}  // namespace refit::cli
+}  // namespace refit
