@@ -14,6 +14,7 @@ import pytest
 import refit
 
 distributed = pytest.importorskip("distributed", reason="python3-distributed is not installed")
+from heap_probe import large_block_mapped_alone  # noqa: E402
 from refit import batch  # noqa: E402
 
 CLI = os.environ.get("REFIT_CLI", "refit")
@@ -101,24 +102,6 @@ def test_bad_body_and_a_worker_killed_mid_run(case):
     assert sum("bind" in e["timings_ms"] for e in done) <= 3  # each worker process binds once (3: one restarted)
 
 
-def large_block_mapped_alone():
-    """In this process: whether glibc maps a fresh 30 MB block on its own (its default
-    below its 32 MB ceiling) rather than taking it from the heap (after
-    refit.keep_freed_memory). The block is kept: freeing it would move glibc's own threshold."""
-    import ctypes
-
-    class MallInfo2(ctypes.Structure):
-        _fields_ = [(n, ctypes.c_size_t) for n in ("arena", "ordblks", "smblks", "hblks", "hblkhd", "usmblks",
-                                                   "fsmblks", "uordblks", "fordblks", "keepcost")]
-
-    libc = ctypes.CDLL("libc.so.6")
-    libc.mallinfo2.restype = MallInfo2
-    libc.malloc.restype = ctypes.c_void_p
-    before = libc.mallinfo2().hblkhd
-    assert libc.malloc(30 << 20)
-    return libc.mallinfo2().hblkhd - before >= 30 << 20
-
-
 def test_workers_keep_freed_memory(case, tmp_path):
     # Dask starts its workers with MALLOC_TRIM_THRESHOLD_=65536: without the workers'
     # refit.keep_freed_memory() each body of a dense garment faulted its memory in
@@ -129,9 +112,9 @@ def test_workers_keep_freed_memory(case, tmp_path):
                                        silence_logs=logging.CRITICAL)
     client = distributed.Client(cluster)
     try:
-        fresh = list(client.run(large_block_mapped_alone).values())
+        fresh = list(client.run(large_block_mapped_alone, 30 << 20).values())
         summary = batch.run(case["job"], batch.read_manifest(str(tmp_path / "one.csv")), client)
-        after = list(client.run(large_block_mapped_alone).values())
+        after = list(client.run(large_block_mapped_alone, 30 << 20).values())
     finally:
         client.close()
         cluster.close()

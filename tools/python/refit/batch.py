@@ -115,7 +115,8 @@ def _bound(job):
             return _bindings[job] + (None,)
         start = time.perf_counter()
         # A worker resizes body after body: freed buffers are kept for the next
-        # one (the 1M dress: about a third less time per body; docs/python.md).
+        # one, overriding the MALLOC_TRIM_THRESHOLD_ Dask starts workers with (the
+        # 1M dress: about half the time per body; docs/python.md).
         refit.keep_freed_memory()
         garment = refit.read_garment(job.garment, keep_text=False)  # write_garment reads the file again
         features = refit.read_features(job.features, units=job.units) if job.features else None
