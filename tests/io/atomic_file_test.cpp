@@ -166,7 +166,7 @@ void die_while_writing(const std::string& folder, int sig) {
 TEST(AtomicFileDeathTest, SigintOrSigtermLeavesNoTemporary) {
   GTEST_FLAG_SET(death_test_style, "threadsafe");
   for (int sig : {SIGINT, SIGTERM}) {
-    test::TempDir dir;
+    const test::DeathTestFolder dir;
     EXPECT_EXIT(die_while_writing(dir.path().string(), sig), ::testing::KilledBySignal(sig), "");
     EXPECT_EQ(entries(dir.path()), 0u) << sig;
   }

@@ -24,6 +24,24 @@ TempDir::~TempDir() {
   std::filesystem::remove_all(path_, ec);
 }
 
+namespace {
+constexpr const char* kDeathTestFolder = "REFIT_TEST_DEATH_FOLDER";
+}
+
+DeathTestFolder::DeathTestFolder() {
+  if (const char* inherited = std::getenv(kDeathTestFolder)) {
+    path_ = inherited;
+    return;
+  }
+  own_ = std::make_unique<TempDir>();
+  path_ = own_->path();
+  ::setenv(kDeathTestFolder, path_.c_str(), 1);
+}
+
+DeathTestFolder::~DeathTestFolder() {
+  if (own_) ::unsetenv(kDeathTestFolder);
+}
+
 std::string shared_data_dir() {
   const std::filesystem::path dir(REFIT_SHARED_DATA);
   if (std::filesystem::exists(dir / "bodies" / "A_female.obj")) return dir.string();

@@ -2,6 +2,7 @@
 // Shared helpers for the test suites: temporary folders, the shared data folder,
 // running the command line.
 #include <filesystem>
+#include <memory>
 #include <string>
 
 namespace refit::test {
@@ -15,6 +16,22 @@ class TempDir {
   std::string file(const std::string& name) const { return (path_ / name).string(); }
 
  private:
+  std::filesystem::path path_;
+};
+
+/// The folder of a death test, the same in its child: in the "threadsafe" style
+/// the child runs the test again from its start in a process of its own, where
+/// a TempDir would be another folder, so the parent's goes to it in the
+/// environment. Made in the parent (and removed there); the child's is the parent's.
+class DeathTestFolder {
+ public:
+  DeathTestFolder();
+  ~DeathTestFolder();
+  const std::filesystem::path& path() const { return path_; }
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  std::unique_ptr<TempDir> own_;  // the parent's
   std::filesystem::path path_;
 };
 
