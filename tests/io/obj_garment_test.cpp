@@ -2,6 +2,7 @@
 // bad input with file:line messages, atomic writes and thread-count independence.
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
+#include <refit/io/obj_detail.hpp>
 #include <refit/io/obj_garment.hpp>
 
 #include "support/test_support.hpp"
@@ -471,6 +472,24 @@ TEST(ObjRead, ErrorLineIsRightInALaterChunk) {
   } catch (const Error& e) {
     EXPECT_THAT(e.what(), StartsWith("late.obj:20001: malformed number 'x'"));
   }
+}
+
+TEST(ObjRead, AParseNeverWritesPastTheVerticesCounted) {
+  // The counting pass saw one `v` line; the text parsed has two (the file
+  // changed between the passes): an error, not a write past the sink's row.
+  using namespace obj_detail;
+  const std::string counted = "v 1 2 3\nf 1 1 1\n", parsed = "v 1 2 3\nv 4 5 6\n";
+  Chunk chunk;
+  count_chunk(counted, 0, counted.size(), chunk);
+  ASSERT_EQ(chunk.nv, 1u);
+  Points positions(1, 3), normals(0, 3);
+  std::vector<ObjSource::Span> vspans(1), nspans;
+  const Sink sink{positions, normals, vspans, nspans};
+  parse_chunk(parsed, 0, parsed.size(), chunk, sink, {}, {1, 0, 0});
+  ASSERT_TRUE(chunk.failure);
+  EXPECT_EQ(chunk.failure->line, 2u);
+  EXPECT_THAT(chunk.failure->message, HasSubstr("changed"));
+  EXPECT_EQ(positions(0, 2), 3.0);
 }
 
 }  // namespace

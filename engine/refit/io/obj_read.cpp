@@ -97,6 +97,9 @@ class ChunkParser {
 
  private:
   [[noreturn]] void fail(std::string message) const { throw ParseFailure{line_, std::move(message)}; }
+  // More `v` or `vn` lines than the counting pass found (a file written to
+  // between the passes, or a mapped one while it is parsed): never past the sink's rows.
+  [[noreturn]] void changed() const { fail("the file changed while it was being read"); }
 
   double number(std::string_view tok, std::string_view kw) const {
     const char* b = tok.data();
@@ -203,6 +206,7 @@ class ChunkParser {
         const std::size_t n = numbers(t, kw, values, 7, &span);
         if (n < 3) fail("'v' needs 3 coordinates, found " + std::to_string(n));
         const std::size_t row = cur_.v - sink_.vertex_base;
+        if (row >= sink_.vspans.size()) changed();
         for (int k = 0; k < 3; ++k) sink_.positions(static_cast<Eigen::Index>(row), k) = values[k];
         sink_.vspans[row] = span;
         ++cur_.v;
@@ -219,6 +223,7 @@ class ChunkParser {
         const std::size_t n = numbers(t, kw, values, 3, &span);
         if (n != 3) fail("'vn' needs 3 numbers, found " + std::to_string(n));
         const std::size_t row = cur_.vn - sink_.normal_base;
+        if (row >= sink_.nspans.size()) changed();
         for (int k = 0; k < 3; ++k) sink_.normals(static_cast<Eigen::Index>(row), k) = values[k];
         sink_.nspans[row] = span;
         ++cur_.vn;
