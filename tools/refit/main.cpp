@@ -5,6 +5,7 @@
 #include <refit/core/error.hpp>
 #include <refit/core/heap.hpp>
 #include <refit/io/atomic_file.hpp>
+#include <refit/io/mapped_file.hpp>
 
 #include <unistd.h>
 
@@ -99,6 +100,7 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   refit::remove_temporaries_on_signal();
+  refit::map_input_files();
   try {
     for (auto& [sub, action] : actions)
       if (sub->parsed()) return action();

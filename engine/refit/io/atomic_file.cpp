@@ -36,8 +36,7 @@ int hold_temporary(const char* path) {
 }
 
 extern "C" void remove_temporaries_and_die(int sig) {
-  for (auto& slot : g_temporary)
-    if (const char* path = slot.load()) ::unlink(path);
+  remove_temporaries_now();
   std::signal(sig, SIG_DFL);
   std::raise(sig);
 }
@@ -190,6 +189,11 @@ void OutputFolder::remove_created() {
     fs::remove(p, ignore);  // only an empty folder goes
   }
   created_.clear();
+}
+
+void remove_temporaries_now() {
+  for (auto& slot : g_temporary)
+    if (const char* path = slot.load()) ::unlink(path);
 }
 
 void remove_temporaries_on_signal() {

@@ -68,6 +68,10 @@ class OutputFolder {
 /// stays ignored. Call once, from main.
 void remove_temporaries_on_signal();
 
+/// Removes the temporaries alive now; safe inside a signal handler (no locks,
+/// no allocation). For a handler that ends the process some other way.
+void remove_temporaries_now();
+
 void write_file_atomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
 /// Appends part k of a text to `out` (an emptied buffer).

@@ -2,8 +2,10 @@
 
 #include <refit/core/error.hpp>
 #include <refit/core/parallel.hpp>
+#include <refit/io/mapped_file.hpp>
 
 #include <atomic>
+#include <utility>
 #include <cerrno>
 #include <cstring>
 #include <fcntl.h>
@@ -11,6 +13,27 @@
 #include <unistd.h>
 
 namespace refit {
+
+TextBytes::TextBytes() = default;
+TextBytes::TextBytes(std::size_t size) : owned_(new char[size]), bytes_(owned_.get()), size_(size) {}
+TextBytes::TextBytes(std::string_view text) : TextBytes(text.size()) { std::copy(text.begin(), text.end(), owned_.get()); }
+TextBytes::TextBytes(std::unique_ptr<MappedFile> mapped)
+    : mapped_(std::move(mapped)), bytes_(mapped_->view().data()), size_(mapped_->view().size()) {}
+TextBytes::TextBytes(TextBytes&& o) noexcept
+    : owned_(std::move(o.owned_)), mapped_(std::move(o.mapped_)), bytes_(std::exchange(o.bytes_, nullptr)),
+      size_(std::exchange(o.size_, 0)) {}
+TextBytes& TextBytes::operator=(TextBytes&& o) noexcept {
+  owned_ = std::move(o.owned_);
+  mapped_ = std::move(o.mapped_);
+  bytes_ = std::exchange(o.bytes_, nullptr);
+  size_ = std::exchange(o.size_, 0);
+  return *this;
+}
+TextBytes::~TextBytes() = default;
+
+void TextBytes::check_unchanged() const {
+  if (mapped_) mapped_->check_unchanged();
+}
 
 int transfer_all(int fd, char* data, std::size_t size, off_t at, bool write) {
   while (size > 0) {
@@ -84,7 +107,9 @@ std::size_t SourceFile::find_newline(std::size_t at) const {
   return size_;
 }
 
-TextBytes read_file_bytes(const std::string& path) {
+TextBytes read_file_bytes(const std::string& path, bool may_map) {
+  if (may_map && input_files_mapped())
+    if (auto mapped = MappedFile::open(path)) return TextBytes(std::move(mapped));
   const SourceFile file(path);
   TextBytes bytes(file.size());
   read_ranges(file.fd(), bytes.data(), bytes.size(), 0, path);

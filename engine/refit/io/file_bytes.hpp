@@ -12,19 +12,31 @@
 
 namespace refit {
 
+class MappedFile;
+
 /// A file's bytes. Unlike std::string it is made without zero-filling, so a large
-/// file goes straight into fresh pages, several threads reading at once.
+/// file goes straight into fresh pages, several threads reading at once; or the
+/// file's own pages, mapped (read_file_bytes with `may_map`).
 class TextBytes {
  public:
-  TextBytes() = default;
-  explicit TextBytes(std::size_t size) : data_(new char[size]), size_(size) {}  // contents unset
-  explicit TextBytes(std::string_view text) : TextBytes(text.size()) { std::copy(text.begin(), text.end(), data_.get()); }
-  char* data() { return data_.get(); }
+  TextBytes();
+  explicit TextBytes(std::size_t size);  // contents unset
+  explicit TextBytes(std::string_view text);
+  explicit TextBytes(std::unique_ptr<MappedFile> mapped);
+  TextBytes(TextBytes&&) noexcept;
+  TextBytes& operator=(TextBytes&&) noexcept;
+  ~TextBytes();
+  char* data() { return owned_.get(); }  // the bytes read into (null when mapped)
   std::size_t size() const { return size_; }
-  std::string_view view() const { return {data_.get(), size_}; }
+  std::string_view view() const { return {bytes_, size_}; }
+  /// Mapped bytes: throws refit::Error naming the file when it was changed in
+  /// place since it was mapped (they may not be what was read). Copies: nothing.
+  void check_unchanged() const;
 
  private:
-  std::unique_ptr<char[]> data_;
+  std::unique_ptr<char[]> owned_;
+  std::unique_ptr<MappedFile> mapped_;
+  const char* bytes_ = nullptr;
   std::size_t size_ = 0;
 };
 
@@ -56,8 +68,10 @@ class SourceFile {
 
 /// The whole regular file at `path`, read by several threads in 8 MB ranges (the
 /// kernel's copy and the first touch of the pages were most of a large garment's
-/// read time on one thread). Throws refit::Error naming `path` when it cannot be
-/// opened, is not a regular file, or cannot be read whole.
-TextBytes read_file_bytes(const std::string& path);
+/// read time on one thread); with `may_map`, in a process that asked for it
+/// (map_input_files, mapped_file.hpp), its pages mapped instead. Throws
+/// refit::Error naming `path` when it cannot be opened, is not a regular file,
+/// or cannot be read whole.
+TextBytes read_file_bytes(const std::string& path, bool may_map = false);
 
 }  // namespace refit

@@ -425,6 +425,7 @@ Garment parse_owned(TextBytes bytes, const std::string& file, SourceText keep) {
     src->text = std::move(bytes);
   } else {
     src->chunk_hash = chunk_hashes(text, bounds);
+    bytes.check_unchanged();  // a mapped file: what was parsed and hashed is the file
   }
   g.source = std::move(src);
   return g;
@@ -437,7 +438,8 @@ Garment parse_garment_obj(std::string_view text, const std::string& file_for_err
 }
 
 Garment read_garment_obj(const std::string& path, SourceText text) {
-  return parse_owned(read_file_bytes(path), path, text);
+  // Mapped only when released: kept text must not change under the writer.
+  return parse_owned(read_file_bytes(path, text == SourceText::released), path, text);
 }
 
 std::string_view source_text(const ObjSource& s, TextBytes& store) {
