@@ -72,12 +72,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::size_t entries(const fs::path& dir) {
-  std::size_t n = 0;
-  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++n;
-  return n;
-}
-
 void write_text_atomically(const std::string& path, const std::string& text) {
   write_file_atomically(path, [&](std::ostream& out) { out << text; });
 }
@@ -95,7 +89,7 @@ TEST(OutputBatch, OutputsAppearOnCommitAndNotBefore) {
   }
   EXPECT_EQ(test::read_text(a), "a\n");
   EXPECT_EQ(test::read_text(b), "b\n");
-  EXPECT_EQ(entries(dir.path()), 2u);
+  EXPECT_EQ(test::folder_entries(dir.path()), 2u);
 }
 
 TEST(OutputBatch, AFailureLeavesNothingNewAndTheOldFilesAlone) {
@@ -111,7 +105,7 @@ TEST(OutputBatch, AFailureLeavesNothingNewAndTheOldFilesAlone) {
   }
   EXPECT_EQ(test::read_text(a), "old\n");
   EXPECT_FALSE(fs::exists(b));
-  EXPECT_EQ(entries(dir.path()), 1u);
+  EXPECT_EQ(test::folder_entries(dir.path()), 1u);
 }
 
 TEST(OutputBatch, AnInnerBatchHandsItsOutputsToTheOuterOne) {
@@ -133,7 +127,7 @@ TEST(OutputBatch, AnInnerBatchHandsItsOutputsToTheOuterOne) {
   }
   EXPECT_TRUE(fs::exists(a));
   EXPECT_FALSE(fs::exists(b));
-  EXPECT_EQ(entries(dir.path()), 1u);
+  EXPECT_EQ(test::folder_entries(dir.path()), 1u);
 }
 
 TEST(OutputFolder, MadeFoldersGoAgainUnlessKept) {
@@ -168,7 +162,7 @@ TEST(AtomicFileDeathTest, SigintOrSigtermLeavesNoTemporary) {
   for (int sig : {SIGINT, SIGTERM}) {
     const test::DeathTestFolder dir;
     EXPECT_EXIT(die_while_writing(dir.path().string(), sig), ::testing::KilledBySignal(sig), "");
-    EXPECT_EQ(entries(dir.path()), 0u) << sig;
+    EXPECT_EQ(test::folder_entries(dir.path()), 0u) << sig;
   }
 }
 

@@ -32,12 +32,6 @@ std::string numbered_strip(int n) {
   return text;
 }
 
-std::size_t files_in(const std::filesystem::path& dir) {
-  std::size_t n = 0;
-  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++n;
-  return n;
-}
-
 TEST(MappedFile, AReleasedGarmentIsReadAsFromACopy) {
   ASSERT_TRUE(map_input_files());
   ASSERT_TRUE(input_files_mapped());
@@ -119,7 +113,7 @@ TEST(MappedFileDeathTest, AMappedInputThatShrinksEndsTheRunWithOneLineAndNoTempo
   test::write_text(in, numbered_strip(20000));
   EXPECT_EXIT(read_past_a_truncated_end(dir.path().string()), ::testing::ExitedWithCode(1),
               "refit: error: .*in.obj: cannot read: the file got shorter while it was being read; nothing written");
-  EXPECT_EQ(files_in(dir.path()), 1u) << "only the input: no output, no temporary";
+  EXPECT_EQ(test::folder_entries(dir.path()), 1u) << "only the input: no output, no temporary";
 }
 
 TEST(MappedFileDeathTest, AnotherBusErrorKeepsItsDefaultAction) {

@@ -41,12 +41,6 @@ std::vector<std::string> split(const std::string& text, const std::string& sep) 
   return out;
 }
 
-std::size_t folder_entries(const std::filesystem::path& dir) {
-  std::size_t n = 0;
-  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++n;
-  return n;
-}
-
 TEST(ObjRead, EveryIndexForm) {
   const Garment g = parse_garment_obj(
       "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
@@ -313,19 +307,19 @@ TEST(ObjWrite, FailedFormatLeavesNoFile) {
   } catch (const Error& e) {
     EXPECT_THAT(e.what(), StartsWith(path + ": vertex 3 has a non-finite coordinate"));
   }
-  EXPECT_EQ(folder_entries(dir.path()), 0u) << "no file and no temporary file";
+  EXPECT_EQ(test::folder_entries(dir.path()), 0u) << "no file and no temporary file";
 
   // A garment that no longer matches its source text.
   Garment h = parse_garment_obj(rich_obj(), "rich.obj");
   h.positions.conservativeResize(6, 3);
   EXPECT_THROW(write_garment_obj(path, h), Error);
-  EXPECT_EQ(folder_entries(dir.path()), 0u);
+  EXPECT_EQ(test::folder_entries(dir.path()), 0u);
 
   // An existing file is left as it was.
   test::write_text(path, "old");
   EXPECT_THROW(write_garment_obj(path, g), Error);
   EXPECT_EQ(test::read_text(path), "old");
-  EXPECT_EQ(folder_entries(dir.path()), 1u);
+  EXPECT_EQ(test::folder_entries(dir.path()), 1u);
 }
 
 // A text spanning several parse chunks, with relative indices crossing chunk
@@ -451,7 +445,7 @@ TEST(ObjWrite, AReleasedSourceWhoseFileChangedIsNotWritten) {
       EXPECT_THAT(std::string(e.what()), HasSubstr("changed"));
     }
     EXPECT_FALSE(std::filesystem::exists(out));
-    EXPECT_EQ(folder_entries(dir.path()), 1u) << "no temporary file left";
+    EXPECT_EQ(test::folder_entries(dir.path()), 1u) << "no temporary file left";
   };
   std::string same_size = text;
   same_size[same_size.size() / 2 + 7] = same_size[same_size.size() / 2 + 7] == '1' ? '2' : '1';  // a digit, late

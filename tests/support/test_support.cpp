@@ -42,6 +42,12 @@ DeathTestFolder::~DeathTestFolder() {
   if (own_) ::unsetenv(kDeathTestFolder);
 }
 
+std::size_t folder_entries(const std::filesystem::path& dir) {
+  std::size_t n = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++n;
+  return n;
+}
+
 std::string shared_data_dir() {
   const std::filesystem::path dir(REFIT_SHARED_DATA);
   if (std::filesystem::exists(dir / "bodies" / "A_female.obj")) return dir.string();

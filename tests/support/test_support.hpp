@@ -35,6 +35,9 @@ class DeathTestFolder {
   std::filesystem::path path_;
 };
 
+/// How many entries the folder holds (files and folders, not recursing).
+std::size_t folder_entries(const std::filesystem::path& dir);
+
 /// ../shared/data, or "" when absent (tests then GTEST_SKIP with a clear message).
 std::string shared_data_dir();
 
