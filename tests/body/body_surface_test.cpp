@@ -348,6 +348,58 @@ TEST(BodySurface, ClosestAndInsideAnswersAsInsideThenClosest) {
   EXPECT_GT(outside_none, 500u);
 }
 
+// Every hint (a triangle that says yes, a far one, none, one out of range)
+// gives the unhinted answer; a yes sets the hint to a triangle that says yes.
+void expect_hints_change_nothing(const BodyMesh& m, const std::vector<Vec3>& points) {
+  const BodySurface s(m);
+  const Index nt = Index(m.triangles.size());
+  std::size_t yes = 0, no = 0, from_the_hint = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Vec3& p = points[i];
+    const Index closest = s.closest(p).triangle;
+    for (double radius : {0.05, 0.3, 1.0}) {
+      const bool expected = s.closer_than(p, radius);
+      (expected ? yes : no) += 1;
+      for (Index hint : {BodySurface::kNoHint, nt + 5, closest, Index((i * 7919) % std::size_t(nt))}) {
+        Index h = hint;
+        ASSERT_EQ(s.closer_than(p, radius, h), expected) << i << " radius " << radius << " hint " << hint;
+        if (!expected) continue;
+        ASSERT_LT(h, nt);
+        ASSERT_LT(s.closest_within(p, radius).distance, radius);
+        Index again = h;  // the triangle it names says yes by itself
+        ASSERT_TRUE(s.closer_than(p, radius, again) && again == h) << i;
+        from_the_hint += h == hint;
+      }
+    }
+  }
+  EXPECT_GT(yes, points.size() / 2);
+  EXPECT_GT(no, points.size() / 2);
+  EXPECT_GT(from_the_hint, points.size() / 2) << "yes answers taken from the hint";
+}
+
+TEST(BodySurface, AHintNeverChangesWhetherAPointIsCloserThan) {
+  const BodyMesh m = test::icosphere(3, 5.0, Vec3(1, 2, 3));
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<std::size_t> pick(0, m.vertices.rows() - 1);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::vector<Vec3> points;
+  for (int i = 0; i < 1500; ++i) {
+    const Vec3 dir3 = Vec3(unit(rng), unit(rng), unit(rng)).normalized();
+    const double offset = std::array<double, 6>{-0.3, -0.02, 0.0, 0.04, 0.5, 3.0}[std::size_t(i) % 6];
+    points.push_back(row3(m.vertices, Index(pick(rng))) + offset * dir3);
+  }
+  expect_hints_change_nothing(m, points);
+}
+
+TEST(BodySurface, AHintNeverChangesWhetherAPointIsCloserThanOnARealBody) {
+  const std::string dir = test::shared_data_dir();
+  if (dir.empty()) GTEST_SKIP() << "shared data (../shared/data) not found";
+  const BodyMesh m = load_obj_body(dir + "/bodies/F_heavier.obj");
+  std::vector<Vec3> points = points_around(m, 11);
+  points.resize(1500);
+  expect_hints_change_nothing(m, points);
+}
+
 TEST(BodySurface, ClearBallsHoldNoBodyPoint) {
   // The collision step skips a face's points inside the balls earlier queries
   // left clear: each `clear` must be no more than the point's true distance to

@@ -157,16 +157,21 @@ struct CloserThanData {
   PointQueryData query;
   double max_distance;
   bool found = false;
+  Index tri = 0;
 };
+
+bool closer_than_test(const CloserThanData& d, Index t) {
+  const std::optional<TrianglePoint> tp = triangle_point(d.query, t);
+  if (!tp) return false;
+  const double d2 = (tp->point - d.query.p).squaredNorm();
+  return d2 <= d.max_distance * d.max_distance && std::sqrt(d2) < d.max_distance;
+}
 
 bool closer_than_callback(RTCPointQueryFunctionArguments* args) {
   auto* d = static_cast<CloserThanData*>(args->userPtr);
-  if (d->found) return false;
-  const std::optional<TrianglePoint> tp = triangle_point(d->query, args->primID);
-  if (!tp) return false;
-  const double d2 = (tp->point - d->query.p).squaredNorm();
-  if (!(d2 <= d->max_distance * d->max_distance) || !(std::sqrt(d2) < d->max_distance)) return false;
+  if (d->found || !closer_than_test(*d, args->primID)) return false;
   d->found = true;
+  d->tri = args->primID;
   args->query->radius = 0.0f;
   return true;
 }
@@ -621,9 +626,16 @@ ClosestPoint BodySurface::closest_within(const Vec3& p, double max_distance) con
 }
 
 bool BodySurface::closer_than(const Vec3& p, double max_distance) const {
+  Index hint = kNoHint;
+  return closer_than(p, max_distance, hint);
+}
+
+bool BodySurface::closer_than(const Vec3& p, double max_distance, Index& hint) const {
   if (!p.allFinite() || !(max_distance > 0.0)) return false;
   CloserThanData d{{&impl_->vertices, &impl_->triangles, &impl_->degenerate, p}, max_distance};
+  if (hint < impl_->triangles.size() && closer_than_test(d, hint)) return true;
   impl_->point_query(p, max_distance, closer_than_callback, &d);
+  if (d.found) hint = d.tri;
   return d.found;
 }
 

@@ -54,6 +54,11 @@ class BodySurface {
   /// at the first triangle that close: a yes needs no closest point (eq. 14's
   /// test of a million garment vertices a body, most of them that close).
   bool closer_than(const Vec3& p, double max_distance) const;
+  /// The same, triangle `hint` tried first (a yes from it needs no search: a
+  /// neighbour's, in a run of neighbouring points); set to the triangle that said
+  /// yes. The answer does not depend on it; kNoHint or out of range: none.
+  static constexpr Index kNoHint = ~Index(0);
+  bool closer_than(const Vec3& p, double max_distance, Index& hint) const;
   /// closest_within() and, when a point was found, inside() from the same query:
   /// within about 1 cm of the surface the closest feature's pseudonormal decides, so
   /// one point query answers both. Nothing within max_distance: distance = +inf

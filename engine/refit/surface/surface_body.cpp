@@ -26,7 +26,10 @@ NearBody SurfaceBinding::near_body(const BodySurface& body_b) const {
   // query ending at the first triangle that close (closer_than).
   const double epsilon = options_.epsilon;
   body_b.prepare_inside_test();
-  return [&body_b, epsilon](const Vec3& p) { return body_b.closer_than(p, epsilon) || body_b.inside(p); };
+  return [&body_b, epsilon](const Vec3& p) {
+    thread_local Index hint = BodySurface::kNoHint;  // this thread's last yes: mostly a neighbour's
+    return body_b.closer_than(p, epsilon, hint) || body_b.inside(p);
+  };
 }
 
 SurfaceResult SurfaceBinding::apply(const Points& warped_vertices, const Points& feature_targets,
