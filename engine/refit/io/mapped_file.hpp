@@ -12,7 +12,7 @@ namespace refit {
 
 /// Garment files read for a resize are mapped from then on instead of copied
 /// into fresh memory (read_file_bytes with `may_map`). On the dense 1M dress
-/// this took the load from about 0.85 to 0.57 s: the kernel's copy and the
+/// this took the load from 0.79 to 0.55 s (medians): the kernel's copy and the
 /// faults of the 144 MB buffer it filled went (bench/README.md, "The garment
 /// file mapped"). A mapped file that shrinks while it is read makes the reads
 /// past its new end fault (SIGBUS): this installs a handler that, for a fault
