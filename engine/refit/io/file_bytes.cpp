@@ -108,9 +108,9 @@ std::size_t SourceFile::find_newline(std::size_t at) const {
 }
 
 TextBytes read_file_bytes(const std::string& path, bool may_map) {
-  if (may_map && input_files_mapped())
-    if (auto mapped = MappedFile::open(path)) return TextBytes(std::move(mapped));
   const SourceFile file(path);
+  if (may_map && input_files_mapped())
+    if (auto mapped = MappedFile::map(file)) return TextBytes(std::move(mapped));
   TextBytes bytes(file.size());
   read_ranges(file.fd(), bytes.data(), bytes.size(), 0, path);
   return bytes;

@@ -55,6 +55,7 @@ class SourceFile {
   SourceFile& operator=(const SourceFile&) = delete;
   std::size_t size() const { return size_; }
   int fd() const { return fd_; }
+  const std::string& path() const { return path_; }
   /// Bytes [at, at + size) into `out` (resized), several threads reading 8 MB ranges at once.
   void read(std::size_t at, std::size_t size, std::string& out) const;
   /// Offset of the first '\n' at or after `at`, or size().

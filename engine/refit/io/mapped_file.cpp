@@ -2,6 +2,7 @@
 
 #include <refit/core/error.hpp>
 #include <refit/io/atomic_file.hpp>
+#include <refit/io/file_bytes.hpp>
 
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -59,9 +60,10 @@ void say_on_stderr(const char* text) {
 
 extern "C" void on_bus_error(int sig, siginfo_t* info, void*) {
   const char* at = static_cast<const char*>(info->si_addr);
+  const bool fault = info->si_code > 0;  // not sent by kill() or raise()
   for (const MappedSlot& s : g_mapped) {
     const char* begin = s.begin.load();
-    if (info->si_code <= 0 || !begin || at < begin || at >= begin + s.size.load()) continue;
+    if (!fault || !begin || at < begin || at >= begin + s.size.load()) continue;
     say_on_stderr("refit: error: ");
     say_on_stderr(s.path.load());
     say_on_stderr(": cannot read: the file got shorter while it was being read; nothing written\n");
@@ -70,7 +72,7 @@ extern "C" void on_bus_error(int sig, siginfo_t* info, void*) {
   }
   // Not a mapped input's: the default action (a fault repeats and ends the process).
   std::signal(sig, SIG_DFL);
-  if (info->si_code <= 0) std::raise(sig);
+  if (!fault) std::raise(sig);
 }
 
 bool same_time(const struct timespec& a, const struct timespec& b) { return a.tv_sec == b.tv_sec && a.tv_nsec == b.tv_nsec; }
@@ -89,18 +91,18 @@ bool map_input_files() {
 
 bool input_files_mapped() { return g_map.load(); }
 
-std::unique_ptr<MappedFile> MappedFile::open(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return nullptr;  // the reader that follows names the problem
+std::unique_ptr<MappedFile> MappedFile::map(const SourceFile& file) {
+  const int fd = ::fcntl(file.fd(), F_DUPFD_CLOEXEC, 0);
+  if (fd < 0) return nullptr;
   struct stat st {};
   void* data = MAP_FAILED;
-  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0)
+  if (::fstat(fd, &st) == 0 && st.st_size > 0)
     data = ::mmap(nullptr, std::size_t(st.st_size), PROT_READ, MAP_PRIVATE, fd, 0);
   if (data == MAP_FAILED) {
     ::close(fd);
     return nullptr;
   }
-  std::unique_ptr<MappedFile> m(new MappedFile(path, fd, st, static_cast<const char*>(data), std::size_t(st.st_size)));
+  std::unique_ptr<MappedFile> m(new MappedFile(file.path(), fd, st, static_cast<const char*>(data), std::size_t(st.st_size)));
   if (m->slot_ < 0) return nullptr;  // more files mapped at once than the handler knows: read instead
   return m;
 }

@@ -10,6 +10,8 @@
 
 namespace refit {
 
+class SourceFile;
+
 /// Garment files read for a resize are mapped from then on instead of copied
 /// into fresh memory (read_file_bytes with `may_map`). On the dense 1M dress
 /// this took the load from 0.79 to 0.55 s (medians): the kernel's copy and the
@@ -30,8 +32,9 @@ bool input_files_mapped();
 /// through: `check_unchanged` says whether any was made since the mapping.
 class MappedFile {
  public:
-  /// Null when the file is empty or the system cannot map it (the caller reads it instead).
-  static std::unique_ptr<MappedFile> open(const std::string& path);
+  /// The open file's pages (it keeps a descriptor of its own); null when the
+  /// file is empty or the system cannot map it (the caller reads it instead).
+  static std::unique_ptr<MappedFile> map(const SourceFile& file);
   ~MappedFile();
   MappedFile(const MappedFile&) = delete;
   MappedFile& operator=(const MappedFile&) = delete;
