@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <span>
 #include <unordered_map>
 
 namespace refit {
@@ -18,6 +19,42 @@ constexpr std::size_t kFoldGrain = 4096;
 // corners' normals: not at a crease (a collar's, a lapel's), where turning it
 // the other way is no fold.
 constexpr double kSmoothAround = 0.5;
+
+// What emit(k, out) appends for k = 0 .. n - 1, in that order: run in
+// parallel, in fixed blocks whose lists are joined in order (the same list for
+// any thread count). emit may write only to what k alone owns.
+template <class Emit>
+std::vector<Index> gathered(std::size_t n, const Emit& emit) {
+  const std::size_t blocks = (n + kFoldGrain - 1) / kFoldGrain;
+  std::vector<std::vector<Index>> found(blocks);
+  parallel_for(0, blocks, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t blk = b; blk < e; ++blk)
+      for (std::size_t k = blk * kFoldGrain; k < std::min(n, (blk + 1) * kFoldGrain); ++k) emit(k, found[blk]);
+  });
+  std::vector<Index> out;
+  for (const auto& list : found) out.insert(out.end(), list.begin(), list.end());
+  return out;
+}
+
+// The entries of `list` with keep(entry), in order.
+template <class Keep>
+std::vector<Index> entries_where(std::span<const Index> list, const Keep& keep) {
+  return gathered(list.size(), [&](std::size_t k, std::vector<Index>& out) {
+    if (keep(list[k])) out.push_back(list[k]);
+  });
+}
+
+// The neighbours w of the vertices of `from` with take(w), in the order a
+// serial walk lists them (from's order, then each vertex's adjacency order),
+// repeats kept. `take` only reads: the caller marks what it keeps in a serial
+// pass over the list.
+template <class Take>
+std::vector<Index> neighbours_where(const Csr& adjacency, std::span<const Index> from, const Take& take) {
+  return gathered(from.size(), [&](std::size_t k, std::vector<Index>& out) {
+    for (Index w : adjacency.row(from[k]))
+      if (take(w)) out.push_back(w);
+  });
+}
 
 // Face normals and, per vertex, the sum of its faces' normals (in face order: the same bits for any thread count).
 struct Orientation {
@@ -60,7 +97,9 @@ struct Orientation {
     const bool many = moved.size() * 16 > vertex.size();
     std::vector<Index> turned, corners;
     if (many) {
-      for (Index v : moved) vertex_mark[v] = stamp - 1;
+      parallel_for(0, moved.size(), kFoldGrain, [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) vertex_mark[moved[k]] = stamp - 1;  // moved lists each vertex once
+      });
       turned = marked(face_mark, stamp - 1, [&](Index f) {
         const auto c = g.faces.row(f);
         return std::any_of(c.begin(), c.end(), [&](Index v) { return vertex_mark[v] == stamp - 1; });
@@ -104,16 +143,9 @@ struct Orientation {
   // parallel (each its own); returns their indices ascending.
   template <class Hit>
   static std::vector<Index> marked(std::vector<std::uint32_t>& marks, std::uint32_t mark, const Hit& hit) {
-    const std::size_t n = marks.size(), blocks = (n + kFoldGrain - 1) / kFoldGrain;
-    std::vector<std::vector<Index>> found(blocks);
-    parallel_for(0, blocks, 1, [&](std::size_t b, std::size_t e) {
-      for (std::size_t blk = b; blk < e; ++blk)
-        for (std::size_t i = blk * kFoldGrain; i < std::min(n, (blk + 1) * kFoldGrain); ++i)
-          if (marks[i] != mark && hit(Index(i))) marks[i] = mark, found[blk].push_back(Index(i));
+    return gathered(marks.size(), [&](std::size_t i, std::vector<Index>& out) {
+      if (marks[i] != mark && hit(Index(i))) marks[i] = mark, out.push_back(Index(i));
     });
-    std::vector<Index> out;
-    for (const auto& list : found) out.insert(out.end(), list.begin(), list.end());
-    return out;
   }
   bool retested(Index f) const { return !face_mark.empty() && face_mark[f] == stamp; }
 };
@@ -176,9 +208,10 @@ bool keep_if_fewer(Orientation& o, Points& positions, const std::vector<Index>& 
   parallel_for(0, retest.size(), 1024, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) was[i] = flags[retest[i]], flags[retest[i]] = flag(retest[i]);
   });
-  std::size_t left = flagged.size();
-  for (std::size_t i = 0; i < retest.size(); ++i) left = left - was[i] + flags[retest[i]];
-  if (left >= flagged.size()) {
+  const auto change = deterministic_sum<std::ptrdiff_t>(0, retest.size(), kFoldGrain, 0, [&](std::size_t i) {
+    return std::ptrdiff_t(flags[retest[i]]) - std::ptrdiff_t(was[i]);
+  });
+  if (change >= 0) {  // no fewer flagged
     for (std::size_t k = 0; k < moved.size(); ++k) positions.row(moved[k]) = kept[k].transpose();
     o.update(positions, moved);
     for (std::size_t i = 0; i < retest.size(); ++i) flags[retest[i]] = was[i];
@@ -187,8 +220,7 @@ bool keep_if_fewer(Orientation& o, Points& positions, const std::vector<Index>& 
   std::vector<Index> now;  // the flagged faces not retested, and the retested ones flagged now
   for (Index f : flagged)
     if (!o.retested(f)) now.push_back(f);
-  for (Index f : retest)
-    if (flags[f]) now.push_back(f);
+  for (Index f : entries_where(retest, [&](Index f) { return flags[f] != 0; })) now.push_back(f);
   std::sort(now.begin(), now.end());
   flagged = std::move(now);
   return true;
@@ -310,6 +342,7 @@ FoldReport smooth_out_folds(const Garment& g, const FoldBinding& binding, Points
     ++rep.rounds;
     const auto round = std::uint32_t(rep.rounds);
     std::vector<Index> front;
+    const auto sorted = std::ptrdiff_t(region.size());  // the rounds before: sorted, each vertex once
     const auto reach = [&](Index v) {
       if (reached[v] == round) return;
       reached[v] = round, front.push_back(v);
@@ -323,7 +356,8 @@ FoldReport smooth_out_folds(const Garment& g, const FoldBinding& binding, Points
       for (Index v : ring)
         for (Index w : adjacency.row(v)) reach(w);
     }
-    std::sort(region.begin(), region.end());
+    std::sort(region.begin() + sorted, region.end());
+    std::inplace_merge(region.begin(), region.begin() + sorted, region.end());
     std::vector<Index> free;
     for (Index v : region)
       if (!(pinned && (*pinned)[v]) && adjacency.row_size(v) > 0) free.push_back(v);
@@ -338,9 +372,9 @@ FoldReport smooth_out_folds(const Garment& g, const FoldBinding& binding, Points
       std::vector<Index> edge(region.begin(), region.end());
       for (int r = 0; r < options.feather; ++r) {
         std::vector<Index> next_ring;
-        for (Index v : edge)
-          for (Index w : adjacency.row(v))
-            if (!in[w] && reached[w] != kFeathered) reached[w] = kFeathered, next_ring.push_back(w);
+        // The first ring's edge is the whole region (400k vertices of the 1M dress on F_thinner).
+        for (Index w : neighbours_where(adjacency, edge, [&](Index w) { return !in[w] && reached[w] != kFeathered; }))
+          if (reached[w] != kFeathered) reached[w] = kFeathered, next_ring.push_back(w);
         band.insert(band.end(), next_ring.begin(), next_ring.end());
         edge.swap(next_ring);
       }
@@ -356,18 +390,19 @@ FoldReport smooth_out_folds(const Garment& g, const FoldBinding& binding, Points
       // neighbour is one or two cache lines, not six of the column arrays (the
       // 1M dress on F_thinner: 10 passes over 207k vertices a round).
       std::vector<Index> local(moving.begin(), moving.end());
-      for (std::size_t k = 0; k < moving.size(); ++k) slot[moving[k]] = Index(k);
+      parallel_for(0, moving.size(), kFoldGrain, [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) slot[moving[k]] = Index(k);  // moving lists each vertex once
+      });
       std::vector<std::size_t> first(moving.size() + 1, 0);
-      for (std::size_t k = 0; k < moving.size(); ++k) {
-        first[k + 1] = first[k] + adjacency.row_size(moving[k]);
-        for (Index w : adjacency.row(moving[k]))
-          if (slot[w] == kNoSlot) slot[w] = Index(local.size()), local.push_back(w);
-      }
+      for (std::size_t k = 0; k < moving.size(); ++k) first[k + 1] = first[k] + adjacency.row_size(moving[k]);
+      for (Index w : neighbours_where(adjacency, moving, [&](Index w) { return slot[w] == kNoSlot; }))
+        if (slot[w] == kNoSlot) slot[w] = Index(local.size()), local.push_back(w);
       std::vector<Index> near(first.back());
-      std::vector<Vec3> now(local.size()), from(local.size()), start(local.size()), next(moving.size());
+      // `next` and `now` take turns; both hold the held neighbours (slots past moving.size()) as they are.
+      std::vector<Vec3> now(local.size()), from(local.size()), start(local.size()), next(local.size());
       parallel_for(0, local.size(), 1024, [&](std::size_t b, std::size_t e) {
         for (std::size_t k = b; k < e; ++k)
-          now[k] = start[k] = row3(positions, local[k]), from[k] = row3(original, local[k]);
+          next[k] = now[k] = start[k] = row3(positions, local[k]), from[k] = row3(original, local[k]);
       });
       parallel_for(0, moving.size(), 1024, [&](std::size_t b, std::size_t e) {
         for (std::size_t k = b; k < e; ++k) {
@@ -375,7 +410,9 @@ FoldReport smooth_out_folds(const Garment& g, const FoldBinding& binding, Points
           for (Index w : adjacency.row(moving[k])) near[at++] = slot[w];
         }
       });
-      for (Index v : local) slot[v] = kNoSlot;
+      parallel_for(0, local.size(), kFoldGrain, [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) slot[local[k]] = kNoSlot;
+      });
       const std::vector<Vec3> kept(now.begin(), now.begin() + std::ptrdiff_t(moving.size()));
       // A vertex takes base + mean(now - base) over its neighbours, base the
       // original for the region (their mean displacement) and the start for the
@@ -400,7 +437,7 @@ FoldReport smooth_out_folds(const Garment& g, const FoldBinding& binding, Points
             next[k] = base_less_mean[k] + sum / double(first[k + 1] - first[k]);
           }
         });
-        std::copy(next.begin(), next.end(), now.begin());
+        now.swap(next);
       }
       parallel_for(0, moving.size(), 1024, [&](std::size_t b, std::size_t e) {
         for (std::size_t k = b; k < e; ++k) positions.row(moving[k]) = now[k].transpose();
@@ -421,14 +458,13 @@ FoldReport smooth_out_folds(const Garment& g, const FoldBinding& binding, Points
   for (Index v : reshape_leaning(binding, o, positions, pinned, options.reshape_rounds)) moved[v] = 1;
   rep.smoothed = std::size_t(std::count(moved.begin(), moved.end(), 1));
   // The folds left: among the ones the smoothing left, and the faces around what the reshaping moved.
-  rep.folded_after = 0;
   std::vector<std::uint8_t> left(nf, 0);
   for (Index f : folded) left[f] = 1;
-  for (std::size_t v = 0; v < nv; ++v)
-    if (moved[v])
-      for (Index f : binding.faces_of_vertex.row(Index(v))) left[f] = 1;
-  for (std::size_t f = 0; f < nf; ++f)
-    if (left[f] && folded_at(f)) ++rep.folded_after;
+  rep.folded_after = deterministic_sum<std::size_t>(0, nf, kFoldGrain, 0, [&](std::size_t f) -> std::size_t {
+    const auto face = g.faces.row(f);
+    const bool around = left[f] || std::any_of(face.begin(), face.end(), [&](Index v) { return moved[v] != 0; });
+    return around && folded_at(f) ? 1 : 0;
+  });
   return rep;
 }
 
