@@ -1,5 +1,6 @@
 // The fold smoothing (surface/folds.hpp): faces turned over against their
 // neighbours are smoothed out; a smooth deformation and pinned vertices are left alone.
+#include <refit/core/parallel.hpp>
 #include <refit/core/topology.hpp>
 #include <refit/surface/folds.hpp>
 
@@ -15,17 +16,17 @@ namespace {
 constexpr int kSide = 21;        // vertices per side
 constexpr double kSpacing = 0.5;
 
-// A flat kSide x kSide grid of triangles in the plane y = 0.
-Garment grid() {
+// A flat side x side grid of triangles in the plane y = 0.
+Garment grid(int side = kSide) {
   Garment g;
-  g.positions.resize(kSide * kSide, 3);
-  for (int i = 0; i < kSide; ++i)
-    for (int k = 0; k < kSide; ++k) g.positions.row(i * kSide + k) << kSpacing * i, 0.0, kSpacing * k;
-  for (int i = 0; i + 1 < kSide; ++i)
-    for (int k = 0; k + 1 < kSide; ++k) {
-      const Index a = Index(i * kSide + k);
-      g.faces.push_row(std::array<Index, 3>{a, a + 1, a + kSide + 1});
-      g.faces.push_row(std::array<Index, 3>{a, a + kSide + 1, a + kSide});
+  g.positions.resize(side * side, 3);
+  for (int i = 0; i < side; ++i)
+    for (int k = 0; k < side; ++k) g.positions.row(i * side + k) << kSpacing * i, 0.0, kSpacing * k;
+  for (int i = 0; i + 1 < side; ++i)
+    for (int k = 0; k + 1 < side; ++k) {
+      const Index a = Index(i * side + k);
+      g.faces.push_row(std::array<Index, 3>{a, a + 1, a + side + 1});
+      g.faces.push_row(std::array<Index, 3>{a, a + side + 1, a + side});
     }
   return g;
 }
@@ -208,6 +209,39 @@ TEST(Folds, FacesLeftTurnedTakeTheirOriginalShapeTurnedAsAround) {
       EXPECT_TRUE(v == kCentre || std::find(ring.begin(), ring.end(), v) != ring.end()) << v;
     }
   }
+}
+
+// The region's walks run in parallel in blocks of thousands of vertices: a
+// grid of 160 x 160 with 121 crumples, whose region spans several blocks,
+// smooths to the same bits with one thread and with two.
+TEST(Folds, TheSameWithOneThreadOrTwo) {
+  constexpr int kBig = 160;
+  const Garment g = grid(kBig);
+  const Csr adjacency = vertex_adjacency(g);
+  const FoldBinding binding = bind_folds(g);
+  const Eigen::Matrix3d map = smooth_map();
+  Points crumples = deformed(g, map);
+  for (int i = 10; i < kBig; i += 14)
+    for (int k = 10; k < kBig; k += 14)
+      crumples.row(i * kBig + k) += (map * Vec3(2.0 * kSpacing, 0.0, 1.3 * kSpacing)).transpose();
+  ASSERT_GE(folds_against(g, crumples, map), 121u);
+  Points one = crumples, two = crumples;
+  FoldReport r1, r2;
+  {
+    const ThreadLimit limit(1);
+    r1 = smooth_out_folds(g, binding, one, adjacency, nullptr);
+  }
+  {
+    const ThreadLimit limit(2);
+    r2 = smooth_out_folds(g, binding, two, adjacency, nullptr);
+  }
+  EXPECT_GT(r1.smoothed, std::size_t(2 * 4096));  // more than one block of the parallel walks
+  EXPECT_EQ(folds_against(g, one, map), 0u);
+  EXPECT_TRUE(one == two);
+  EXPECT_EQ(r1.folded_before, r2.folded_before);
+  EXPECT_EQ(r1.folded_after, r2.folded_after);
+  EXPECT_EQ(r1.smoothed, r2.smoothed);
+  EXPECT_EQ(r1.rounds, r2.rounds);
 }
 
 TEST(Folds, NothingChangesWhenSmoothingCannotHelp) {
