@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -34,25 +35,18 @@ struct Constraint {
   bool inside = false;
 };
 
-using Found = std::vector<std::vector<std::pair<Index, Constraint>>>;
+using Found = std::vector<std::pair<Index, Constraint>>;
 
 // One constraint per constrained vertex, ascending: the vertex's own (from
-// `own`, blocks in ascending vertex order, a vertex at most once) first, then
+// `own`, ascending, a vertex at most once) first, then
 // its faces' in face order, the largest amount kept (the first of equal ones,
 // with the first's `inside`). The faces' entries are sorted by (vertex, order)
 // keys, in parallel: a stable sort of the million pairs of a dense garment's
 // first round took a tenth of a second.
 void merge_constraints(const Found& own, const Found& faces, std::vector<Index>& active, std::vector<Constraint>& con) {
-  std::vector<std::size_t> start(faces.size() + 1, 0);
-  for (std::size_t b = 0; b < faces.size(); ++b) start[b + 1] = start[b] + faces[b].size();
-  std::vector<const std::pair<Index, Constraint>*> entry(start.back());
-  UninitVector<std::uint64_t> key(start.back());
-  parallel_for(0, faces.size(), 1, [&](std::size_t bb, std::size_t be) {
-    for (std::size_t b = bb; b < be; ++b)
-      for (std::size_t k = 0; k < faces[b].size(); ++k) {
-        entry[start[b] + k] = &faces[b][k];
-        key[start[b] + k] = (std::uint64_t(faces[b][k].first) << 32) | std::uint64_t(start[b] + k);
-      }
+  UninitVector<std::uint64_t> key(faces.size());
+  parallel_for(0, faces.size(), 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) key[k] = (std::uint64_t(faces[k].first) << 32) | std::uint64_t(k);
   });
   tbb::parallel_sort(key.begin(), key.end());
   const auto take = [&](Index i, const Constraint& c) {
@@ -66,15 +60,14 @@ void merge_constraints(const Found& own, const Found& faces, std::vector<Index>&
   std::size_t f = 0;
   const auto faces_up_to = [&](Index last) {  // the faces' entries of vertices up to `last`
     for (; f < key.size() && Index(key[f] >> 32) <= last; ++f) {
-      const auto& [i, c] = *entry[key[f] & 0xffffffffu];
+      const auto& [i, c] = faces[key[f] & 0xffffffffu];
       take(i, c);
     }
   };
-  for (const auto& list : own)
-    for (const auto& [i, c] : list) {
-      if (i > 0) faces_up_to(i - 1);
-      take(i, c);
-    }
+  for (const auto& [i, c] : own) {
+    if (i > 0) faces_up_to(i - 1);
+    take(i, c);
+  }
   faces_up_to(std::numeric_limits<Index>::max());
 }
 
@@ -392,25 +385,22 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
   };
   // touch() for every vertex of a region (ascending), the list and the starts filled in parallel.
   const auto touch_all = [&](const std::vector<Index>& region) {
-    std::vector<std::vector<Index>> fresh((region.size() + kGrain - 1) / kGrain);
-    parallel_for(0, fresh.size(), 1, [&](std::size_t b, std::size_t e) {
-      for (std::size_t blk = b; blk < e; ++blk)
-        for (std::size_t k = blk * kGrain; k < std::min(region.size(), (blk + 1) * kGrain); ++k)
-          if (!is_touched[region[k]]) fresh[blk].push_back(region[k]);
-    });
-    std::vector<std::size_t> at(fresh.size() + 1, touched.size());
-    for (std::size_t blk = 0; blk < fresh.size(); ++blk) at[blk + 1] = at[blk] + fresh[blk].size();
-    touched.resize(at.back());
-    first_position.resize(at.back());
-    parallel_for(0, fresh.size(), 1, [&](std::size_t b, std::size_t e) {
-      for (std::size_t blk = b; blk < e; ++blk)
-        for (std::size_t k = 0; k < fresh[blk].size(); ++k) {
-          const Index i = fresh[blk][k];
-          is_touched[i] = 1;
-          touched_slot[i] = Index(at[blk] + k);
-          touched[at[blk] + k] = i;
-          first_position[at[blk] + k] = row3(positions, i);
-        }
+    const std::vector<Index> fresh =
+        gather_in_blocks<Index>(region.size(), kGrain, [&](std::size_t first, std::size_t last, std::vector<Index>& out) {
+          for (std::size_t k = first; k < last; ++k)
+            if (!is_touched[region[k]]) out.push_back(region[k]);
+        });
+    const std::size_t at = touched.size();
+    touched.resize(at + fresh.size());
+    first_position.resize(at + fresh.size());
+    parallel_for(0, fresh.size(), kGrain, [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) {
+        const Index i = fresh[k];
+        is_touched[i] = 1;
+        touched_slot[i] = Index(at + k);
+        touched[at + k] = i;
+        first_position[at + k] = row3(positions, i);
+      }
     });
   };
   // One round: `all`: check every vertex and face (else those of to_check);
@@ -422,22 +412,21 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     const std::size_t count = all ? n : to_check.size();
     if (!all) report.rechecked += count;
     constexpr std::size_t kBlock = kGrain / 4;
-    std::vector<std::vector<std::pair<Index, Constraint>>> found((count + kBlock - 1) / kBlock);
-    parallel_for(0, found.size(), 1, [&](std::size_t b, std::size_t e) {
-      for (std::size_t blk = b; blk < e; ++blk)
-        for (std::size_t k = blk * kBlock; k < std::min(count, (blk + 1) * kBlock); ++k) {
-          const Index i = all ? static_cast<Index>(k) : to_check[k];
-          if (!finite[i]) continue;
-          const Vec3 p = row3(positions, i);
-          const SignedClosestPoint cp = body_b.closest_and_inside(p, reach);
-          const bool in = cp.inside;
-          outside_by[i] = in ? 0.0 : std::min(cp.distance, reach);
-          near_point[i] = cp.point;
-          near_distance[i] = cp.distance;
-          const Constraint c = constraint_at(p, in, cp, options.clearance);
-          if (c.active) found[blk].emplace_back(i, c);
-        }
-    });
+    const Found found = gather_in_blocks<Found::value_type>(
+        count, kBlock, [&](std::size_t first, std::size_t last, Found& out) {
+          for (std::size_t k = first; k < last; ++k) {
+            const Index i = all ? static_cast<Index>(k) : to_check[k];
+            if (!finite[i]) continue;
+            const Vec3 p = row3(positions, i);
+            const SignedClosestPoint cp = body_b.closest_and_inside(p, reach);
+            const bool in = cp.inside;
+            outside_by[i] = in ? 0.0 : std::min(cp.distance, reach);
+            near_point[i] = cp.point;
+            near_distance[i] = cp.distance;
+            const Constraint c = constraint_at(p, in, cp, options.clearance);
+            if (c.active) out.emplace_back(i, c);
+          }
+        });
     // Faces too: a coarse face whose corners all clear the body can still have
     // the body poking through its middle (the real dress's bust: 115 face centres
     // inside body B, none of its corners). A face whose centre is inside or too
@@ -446,8 +435,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     // A face with a constrained corner waits for the next round: that corner's own
     // move usually clears it, and asking its other corners now as well lifted
     // vertices that sat on the body (the real jeans: 0.13 cm off body A, 0.81 off B).
-    for (const auto& list : found)
-      for (const auto& ic : list) constrained[ic.first] = 1;
+    for (const auto& ic : found) constrained[ic.first] = 1;
     std::vector<std::uint8_t> check_face_of(all ? 0 : n, 0);
     if (all) face_inside_before.assign(g.faces.rows(), 0);
     for (std::size_t k = 0; !all && k < count; ++k) check_face_of[to_check[k]] = 1;
@@ -459,122 +447,114 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     const bool scan = all || !few_vertices(count, n);
     const std::vector<Index> listed = scan ? std::vector<Index>{} : faces_around(faces_of(), to_check);
     const std::size_t asked = scan ? nf : listed.size();
-    std::vector<std::vector<std::pair<Index, Constraint>>> face_found((asked + kBlock - 1) / kBlock);
-    std::vector<std::size_t> faces_in(face_found.size(), 0);
-    parallel_for(0, face_found.size(), 1, [&](std::size_t b, std::size_t e) {
-      std::vector<Constraint> need;
-      for (std::size_t blk = b; blk < e; ++blk)
-        for (std::size_t k = blk * kBlock; k < std::min(asked, (blk + 1) * kBlock); ++k) {
-          const std::size_t f = scan ? k : std::size_t(listed[k]);
-          const auto face = g.faces.row(f);
-          if (face.size() < 3) continue;
-          bool check = all, ok = true;
-          for (Index v : face) {
-            check = check || check_face_of[v];
-            ok = ok && finite[v];
+    std::atomic<std::size_t> faces_in{0};
+    Found face_found = gather_in_blocks<Found::value_type>(
+        asked, kBlock, [&](std::size_t first, std::size_t last, Found& out) {
+          std::vector<Constraint> need;
+          for (std::size_t k = first; k < last; ++k) {
+            const std::size_t f = scan ? k : std::size_t(listed[k]);
+            const auto face = g.faces.row(f);
+            if (face.size() < 3) continue;
+            bool check = all, ok = true;
+            for (Index v : face) {
+              check = check || check_face_of[v];
+              ok = ok && finite[v];
+            }
+            if (!check || !ok) continue;
+            // Only counted (not asked of) while a corner is constrained, so only
+            // inside or not is needed, and only for round 1's count.
+            const bool waits =
+                !last_round && std::any_of(face.begin(), face.end(), [&](Index v) { return constrained[v] != 0; });
+            if (waits && !all) continue;
+            const bool in =
+                face_needs(g, positions, f, body_b, options.face_clearance, options.probe_radius, options.pinned,
+                           &outside_by, waits ? nullptr : &need);
+            if (in) ++faces_in;
+            if (!in) clear_at[f] = moves_done + 1;
+            if (all) face_inside_before[f] = in;
+            if (waits) continue;
+            for (std::size_t i = 0; i < face.size(); ++i)
+              if (need[i].active) out.emplace_back(face[i], need[i]);
           }
-          if (!check || !ok) continue;
-          // Only counted (not asked of) while a corner is constrained, so only
-          // inside or not is needed, and only for round 1's count.
-          const bool waits =
-              !last_round && std::any_of(face.begin(), face.end(), [&](Index v) { return constrained[v] != 0; });
-          if (waits && !all) continue;
-          const bool in =
-              face_needs(g, positions, f, body_b, options.face_clearance, options.probe_radius, options.pinned,
-                         &outside_by, waits ? nullptr : &need);
-          faces_in[blk] += in;
-          if (!in) clear_at[f] = moves_done + 1;
-          if (all) face_inside_before[f] = in;
-          if (waits) continue;
-          for (std::size_t i = 0; i < face.size(); ++i)
-            if (need[i].active) face_found[blk].emplace_back(face[i], need[i]);
-        }
-    });
+        });
     // Layers: an outer point closer to its inner vertex than it keeps. The inner
     // vertex goes down by what it may (the outer layer is what shows, and the
     // feature curves sit on it); the rest the outer triangle's corners take,
     // outward, each its least-squares share (as for a face sample).
-    const std::size_t face_blocks = face_found.size();  // the faces' own, before the layers'
+    const std::size_t face_own = face_found.size();  // the faces' own, before the layers'
     if (options.layers) {
       const auto& covers = *options.layers;
-      face_found.emplace_back();
-      std::vector<std::vector<std::pair<Index, Constraint>>> layer_found((covers.size() + kBlock - 1) / kBlock);
-      std::vector<std::size_t> crossed(layer_found.size(), 0);
-      parallel_for(0, layer_found.size(), 1, [&](std::size_t b, std::size_t e) {
-        for (std::size_t blk = b; blk < e; ++blk)
-          for (std::size_t k = blk * kBlock; k < std::min(covers.size(), (blk + 1) * kBlock); ++k) {
-            const LayerCover& c = covers[k];
-            const bool check = all || check_face_of[c.inner] || check_face_of[c.outer[0]] || check_face_of[c.outer[1]] ||
-                               check_face_of[c.outer[2]];
-            if (!check || !finite[c.inner] || !finite[c.outer[0]] || !finite[c.outer[1]] || !finite[c.outer[2]]) continue;
-            if (all) cover_start[k] = near_distance[c.inner];
-            const auto [height, normal] = cover_height(c, positions);
-            const double rounding = kCoverRounding * (1.0 + row3(positions, c.inner).cwiseAbs().maxCoeff());
-            if (!(height < c.keep - rounding)) continue;
-            ++crossed[blk];
-            const double short_by = c.keep - height;
-            // It sinks by at most max_lift from where the step found it, as a vertex
-            // near the body rises by at most that beyond its need.
-            // Nor when the body or its faces push it out, in this round or the one
-            // before: taken down, it was lifted again by the next push, round after
-            // round, and ended through the layer over it (the real outfit on
-            // F_taller: the jeans through the dress at the back waist, 15 covers
-            // short after the step); the layer over it goes up instead, unless a
-            // corner of it is pinned (beside a curve, where moving it took the
-            // written garment off the curves).
-            const auto pinned = [&](Index v) { return options.pinned && (*options.pinned)[v]; };
-            const bool inner_pinned = pinned(c.inner);
-            const bool pushed = (constrained[c.inner] || pushed_out[c.inner]) && !pinned(c.outer[0]) &&
-                                !pinned(c.outer[1]) && !pinned(c.outer[2]);
-            const double floor = std::max(options.clearance, cover_start[k] - options.max_lift);
-            const double room = inner_pinned || pushed                ? 0.0
-                                : std::isfinite(near_distance[c.inner]) ? near_distance[c.inner] - floor
-                                                                        : short_by;
-            const double down = std::clamp(room, 0.0, short_by), up = short_by - down;
-            if (down > rounding) layer_found[blk].emplace_back(c.inner, Constraint{-normal, down, true, false});
-            if (!(up > rounding)) continue;
-            // Neither layer moves the corners the feature curves sit on (pinned):
-            // the written garment keeps passing through the curves.
-            // With most of the point's weight on pinned corners the free ones would
-            // have to move many times the shortfall: left crossed (as face_needs leaves
-            // such a face to its pinned corners).
-            std::array<double, 3> w = c.weight;
-            for (int j = 0; j < 3; ++j)
-              if (pinned(c.outer[std::size_t(j)])) w[std::size_t(j)] = 0.0;
-            if (!(w[0] + w[1] + w[2] >= 0.5)) continue;
-            const double norm2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
-            for (int j = 0; j < 3; ++j)
-              if (w[std::size_t(j)] > 0.0)
-                layer_found[blk].emplace_back(c.outer[std::size_t(j)], Constraint{normal, up * w[std::size_t(j)] / norm2, true, false});
-          }
-      });
-      for (auto& list : layer_found) face_found.back().insert(face_found.back().end(), list.begin(), list.end());
+      std::atomic<std::size_t> crossed{0};
+      const Found layer_found = gather_in_blocks<Found::value_type>(
+          covers.size(), kBlock, [&](std::size_t first, std::size_t last, Found& out) {
+            for (std::size_t k = first; k < last; ++k) {
+              const LayerCover& c = covers[k];
+              const bool check = all || check_face_of[c.inner] || check_face_of[c.outer[0]] || check_face_of[c.outer[1]] ||
+                                 check_face_of[c.outer[2]];
+              if (!check || !finite[c.inner] || !finite[c.outer[0]] || !finite[c.outer[1]] || !finite[c.outer[2]]) continue;
+              if (all) cover_start[k] = near_distance[c.inner];
+              const auto [height, normal] = cover_height(c, positions);
+              const double rounding = kCoverRounding * (1.0 + row3(positions, c.inner).cwiseAbs().maxCoeff());
+              if (!(height < c.keep - rounding)) continue;
+              ++crossed;
+              const double short_by = c.keep - height;
+              // It sinks by at most max_lift from where the step found it, as a vertex
+              // near the body rises by at most that beyond its need.
+              // Nor when the body or its faces push it out, in this round or the one
+              // before: taken down, it was lifted again by the next push, round after
+              // round, and ended through the layer over it (the real outfit on
+              // F_taller: the jeans through the dress at the back waist, 15 covers
+              // short after the step); the layer over it goes up instead, unless a
+              // corner of it is pinned (beside a curve, where moving it took the
+              // written garment off the curves).
+              const auto pinned = [&](Index v) { return options.pinned && (*options.pinned)[v]; };
+              const bool inner_pinned = pinned(c.inner);
+              const bool pushed = (constrained[c.inner] || pushed_out[c.inner]) && !pinned(c.outer[0]) &&
+                                  !pinned(c.outer[1]) && !pinned(c.outer[2]);
+              const double floor = std::max(options.clearance, cover_start[k] - options.max_lift);
+              const double room = inner_pinned || pushed                ? 0.0
+                                  : std::isfinite(near_distance[c.inner]) ? near_distance[c.inner] - floor
+                                                                          : short_by;
+              const double down = std::clamp(room, 0.0, short_by), up = short_by - down;
+              if (down > rounding) out.emplace_back(c.inner, Constraint{-normal, down, true, false});
+              if (!(up > rounding)) continue;
+              // Neither layer moves the corners the feature curves sit on (pinned):
+              // the written garment keeps passing through the curves.
+              // With most of the point's weight on pinned corners the free ones would
+              // have to move many times the shortfall: left crossed (as face_needs leaves
+              // such a face to its pinned corners).
+              std::array<double, 3> w = c.weight;
+              for (int j = 0; j < 3; ++j)
+                if (pinned(c.outer[std::size_t(j)])) w[std::size_t(j)] = 0.0;
+              if (!(w[0] + w[1] + w[2] >= 0.5)) continue;
+              const double norm2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+              for (int j = 0; j < 3; ++j)
+                if (w[std::size_t(j)] > 0.0)
+                  out.emplace_back(c.outer[std::size_t(j)], Constraint{normal, up * w[std::size_t(j)] / norm2, true, false});
+            }
+          });
+      face_found.insert(face_found.end(), layer_found.begin(), layer_found.end());
       if (all) {
         report.layer_covers = covers.size();
-        for (std::size_t k : crossed) report.layers_crossed_before += k;
+        report.layers_crossed_before += crossed;
       }
     }
-    for (const auto& list : found)
-      for (const auto& ic : list) constrained[ic.first] = 0;
-    std::size_t vertex_constraints = 0;
-    for (const auto& list : found) vertex_constraints += list.size();
+    for (const auto& ic : found) constrained[ic.first] = 0;
+    const std::size_t vertex_constraints = found.size();
     std::vector<Index> active;  // ascending
     std::vector<Constraint> con;  // aligned with `active`
     merge_constraints(found, face_found, active, con);
     if (options.layers) {  // what the body pushes out in this round, for the covers of the next
       for (Index i : pushed_list) pushed_out[i] = 0;
       pushed_list.clear();
-      for (const auto& list : found)
-        for (const auto& ic : list) pushed_list.push_back(ic.first);
-      for (std::size_t b = 0; b < face_blocks; ++b)
-        for (const auto& ic : face_found[b]) pushed_list.push_back(ic.first);
+      for (const auto& ic : found) pushed_list.push_back(ic.first);
+      for (std::size_t k = 0; k < face_own; ++k) pushed_list.push_back(face_found[k].first);
       for (Index i : pushed_list) pushed_out[i] = 1;
     }
     if (all) {
       report.too_close = vertex_constraints;
-      for (const auto& list : found)
-        for (const auto& ic : list) report.inside_before += ic.second.inside ? 1 : 0;
-      for (std::size_t k : faces_in) report.faces_inside_before += k;
+      for (const auto& ic : found) report.inside_before += ic.second.inside ? 1 : 0;
+      report.faces_inside_before += faces_in;
     }
     if (active.empty()) return false;
     ++report.rounds;
@@ -607,23 +587,21 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     // takes them: the same rings and the same lists).
     for (int level = max_rings; level > 0; --level) {
       const std::vector<Index>& from = at_level[std::size_t(level)];
-      std::vector<std::vector<Index>> reach((from.size() + kGrain - 1) / kGrain);
-      parallel_for(0, reach.size(), 1, [&](std::size_t b, std::size_t e) {
-        for (std::size_t blk = b; blk < e; ++blk)
-          for (std::size_t k = blk * kGrain; k < std::min(from.size(), (blk + 1) * kGrain); ++k) {
-            const Index v = from[k];
-            if (ring[v] != level) continue;  // reached since from a larger correction
-            for (Index j : adj.row(v))
-              if (ring[j] < level - 1 && finite[j]) reach[blk].push_back(j);
-          }
-      });
-      for (const auto& list : reach)
-        for (Index j : list)
-          if (ring[j] < level - 1) {
-            if (ring[j] < 0) region.push_back(j);
-            ring[j] = level - 1;
-            at_level[std::size_t(level - 1)].push_back(j);
-          }
+      const std::vector<Index> reach =
+          gather_in_blocks<Index>(from.size(), kGrain, [&](std::size_t first, std::size_t last, std::vector<Index>& out) {
+            for (std::size_t k = first; k < last; ++k) {
+              const Index v = from[k];
+              if (ring[v] != level) continue;  // reached since from a larger correction
+              for (Index j : adj.row(v))
+                if (ring[j] < level - 1 && finite[j]) out.push_back(j);
+            }
+          });
+      for (Index j : reach)
+        if (ring[j] < level - 1) {
+          if (ring[j] < 0) region.push_back(j);
+          ring[j] = level - 1;
+          at_level[std::size_t(level - 1)].push_back(j);
+        }
     }
     tbb::parallel_sort(region.begin(), region.end());  // mesh order: deterministic and cache-friendly
     touch_all(region);

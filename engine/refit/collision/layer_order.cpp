@@ -145,31 +145,26 @@ std::vector<LayerCover> bind_layer_order(const Garment& g, const std::vector<std
     around.erase(std::unique(around.begin(), around.end()), around.end());
     const auto close_to_candidates = [&](const Vec3& p) { return std::binary_search(around.begin(), around.end(), cells.key(p)); };
     // Their fan triangles (corners in the garment's numbering), for rays.
-    std::vector<std::vector<std::array<Index, 3>>> part((g.faces.rows() + 4095) / 4096);
-    parallel_for(0, part.size(), 1, [&](std::size_t b, std::size_t e) {
-      for (std::size_t blk = b; blk < e; ++blk)
-        for (std::size_t f = blk * 4096; f < std::min(g.faces.rows(), (blk + 1) * 4096); ++f) {
-          const auto face = g.faces.row(f);
-          const bool other_layer = std::all_of(face.begin(), face.end(), [&](Index v) {
-            return vertex_layer[v] != 0 && vertex_layer[v] != layer;
-          });
-          if (!other_layer || !close_to_candidates(row3(g.positions, face[0]))) continue;
-          for (std::size_t k = 1; k + 1 < face.size(); ++k) part[blk].push_back({face[0], face[k], face[k + 1]});
-        }
-    });
-    std::vector<std::array<Index, 3>> others;
-    for (const auto& list : part) others.insert(others.end(), list.begin(), list.end());
+    const std::vector<std::array<Index, 3>> others = gather_in_blocks<std::array<Index, 3>>(
+        g.faces.rows(), 4096, [&](std::size_t first, std::size_t last, std::vector<std::array<Index, 3>>& out) {
+          for (std::size_t f = first; f < last; ++f) {
+            const auto face = g.faces.row(f);
+            const bool other_layer = std::all_of(face.begin(), face.end(), [&](Index v) {
+              return vertex_layer[v] != 0 && vertex_layer[v] != layer;
+            });
+            if (!other_layer || !close_to_candidates(row3(g.positions, face[0]))) continue;
+            for (std::size_t k = 1; k + 1 < face.size(); ++k) out.push_back({face[0], face[k], face[k + 1]});
+          }
+        });
     if (others.empty()) continue;
     EmbreeScene scene(device.get(), RTC_BUILD_QUALITY_LOW);  // built once, a ray per candidate
     scene.add_triangles(g.positions, others, "layers");
     scene.commit("layers");
-    constexpr std::size_t kBlock = 1024;
-    std::vector<std::vector<LayerCover>> found((candidates.size() + kBlock - 1) / kBlock);
-    parallel_for(0, found.size(), 1, [&](std::size_t b, std::size_t e) {
-      RTCIntersectContext ctx;
-      rtcInitIntersectContext(&ctx);
-      for (std::size_t blk = b; blk < e; ++blk)
-        for (std::size_t k = blk * kBlock; k < std::min(candidates.size(), (blk + 1) * kBlock); ++k) {
+    const std::vector<LayerCover> found = gather_in_blocks<LayerCover>(
+        candidates.size(), 1024, [&](std::size_t first, std::size_t last, std::vector<LayerCover>& out) {
+        RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        for (std::size_t k = first; k < last; ++k) {
           // The other layer straight out from the vertex, away from body A.
           const Vec3 p = row3(g.positions, candidates[k]), away = outward(body_a, p);
           RTCRayHit rh = make_ray(p, away);
@@ -184,10 +179,10 @@ std::vector<LayerCover> bind_layer_order(const Garment& g, const std::vector<std
           const double height = cover_height(c, g.positions).first;
           if (!(height > 0.0 && std::isfinite(height))) continue;
           c.keep = std::min(height, gap);
-          found[blk].push_back(c);
+          out.push_back(c);
         }
-    });
-    for (auto& list : found) covers.insert(covers.end(), list.begin(), list.end());
+      });
+    covers.insert(covers.end(), found.begin(), found.end());
   }
   std::sort(covers.begin(), covers.end(), [](const LayerCover& a, const LayerCover& b) { return a.inner < b.inner; });
   return covers;

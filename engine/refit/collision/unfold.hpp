@@ -53,17 +53,13 @@ void unfold(const Garment& g, const Points& positions, const std::vector<Index>&
     for (Index f : faces_around(faces_of_vertex(), region))
       if (g.faces.row_size(f) >= 3) faces.push_back(f);
   } else {
-    constexpr std::size_t kBlock = 4096;
-    std::vector<std::vector<Index>> found((nf + kBlock - 1) / kBlock);
-    parallel_for(0, found.size(), 1, [&](std::size_t b, std::size_t e) {
-      for (std::size_t blk = b; blk < e; ++blk)
-        for (std::size_t f = blk * kBlock; f < std::min(nf, (blk + 1) * kBlock); ++f) {
-          const auto face = g.faces.row(f);
-          if (face.size() >= 3 && std::any_of(face.begin(), face.end(), [&](Index v) { return slot_of(v) >= 0; }))
-            found[blk].push_back(Index(f));
-        }
+    faces = gather_in_blocks<Index>(nf, 4096, [&](std::size_t first, std::size_t last, std::vector<Index>& out) {
+      for (std::size_t f = first; f < last; ++f) {
+        const auto face = g.faces.row(f);
+        if (face.size() >= 3 && std::any_of(face.begin(), face.end(), [&](Index v) { return slot_of(v) >= 0; }))
+          out.push_back(Index(f));
+      }
     });
-    for (const auto& list : found) faces.insert(faces.end(), list.begin(), list.end());
   }
   std::vector<Vec3> before(faces.size());
   parallel_for(0, faces.size(), 256, [&](std::size_t b, std::size_t e) {

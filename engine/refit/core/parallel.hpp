@@ -7,8 +7,10 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <memory>
+#include <vector>
 
 namespace refit {
 
@@ -33,6 +35,30 @@ T deterministic_sum(std::size_t first, std::size_t last, std::size_t grain, T ze
         return acc;
       },
       [](T a, const T& b) { return a += b; });
+}
+
+/// What emit(first, last, out) appends to `out` for the fixed blocks
+/// [first, last) of `block` indices that cover [0, n), run in parallel and
+/// joined in block order: the same list whatever the thread count. emit may
+/// write only to `out` and to what its own indices own.
+template <class T, class Emit>
+std::vector<T> gather_in_blocks(std::size_t n, std::size_t block, Emit&& emit) {
+  if (block == 0) block = 1;
+  const std::size_t blocks = (n + block - 1) / block;
+  std::vector<std::vector<T>> lists(blocks);
+  parallel_for(0, blocks, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) emit(k * block, std::min(n, (k + 1) * block), lists[k]);
+  });
+  std::vector<std::size_t> start(blocks + 1, 0);
+  for (std::size_t k = 0; k < blocks; ++k) start[k + 1] = start[k] + lists[k].size();
+  std::vector<T> out(start.back());
+  parallel_for(0, blocks, 8, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) {
+      std::move(lists[k].begin(), lists[k].end(), out.begin() + std::ptrdiff_t(start[k]));
+      std::vector<T>().swap(lists[k]);
+    }
+  });
+  return out;
 }
 
 /// Caps the worker threads while alive (0 = no cap).

@@ -48,40 +48,33 @@ SliceResult slice_garment(const Garment& g, const FeaturePlane& plane, double we
   });
   auto above = [&](Index i) { return s[i] >= 0.0; };
 
-  // Fixed blocks of faces, each with its own output: concatenated in block
-  // order, the segments do not depend on the thread count.
-  const std::size_t faces = g.faces.rows();
-  constexpr std::size_t kBlock = 1 << 13;
-  const std::size_t blocks = (faces + kBlock - 1) / kBlock;
-  std::vector<std::vector<Segment>> out(blocks);
-  parallel_for(0, blocks, 1, [&](std::size_t b0, std::size_t b1) {
-    std::vector<std::pair<double, Vec3>> cuts;
-    for (std::size_t blk = b0; blk < b1; ++blk) {
-      const std::size_t f1 = std::min(faces, (blk + 1) * kBlock);
-      for (std::size_t f = blk * kBlock; f < f1; ++f) {
-        const auto row = g.faces.row(f);
-        const std::size_t k = row.size();
-        bool any_up = false, any_down = false;
-        for (Index v : row) (above(v) ? any_up : any_down) = true;
-        if (!(any_up && any_down)) continue;
-        cuts.clear();
-        for (std::size_t c = 0; c < k; ++c) {
-          const Index a = row[c], bb = row[(c + 1) % k];
-          if (above(a) != above(bb)) cuts.emplace_back(0.0, crossing(P, s, a, bb));
+  // The segments in face order, whatever the thread count.
+  const std::vector<Segment> segments =
+      gather_in_blocks<Segment>(g.faces.rows(), 1 << 13, [&](std::size_t first, std::size_t last, std::vector<Segment>& out) {
+        std::vector<std::pair<double, Vec3>> cuts;
+        for (std::size_t f = first; f < last; ++f) {
+          const auto row = g.faces.row(f);
+          const std::size_t k = row.size();
+          bool any_up = false, any_down = false;
+          for (Index v : row) (above(v) ? any_up : any_down) = true;
+          if (!(any_up && any_down)) continue;
+          cuts.clear();
+          for (std::size_t c = 0; c < k; ++c) {
+            const Index a = row[c], bb = row[(c + 1) % k];
+            if (above(a) != above(bb)) cuts.emplace_back(0.0, crossing(P, s, a, bb));
+          }
+          if (cuts.size() > 2) {
+            // Non-convex polygon: order the crossings along the cut line (plane
+            // normal x Newell face normal) and pair them up.
+            Vec3 fn = Vec3::Zero();
+            for (std::size_t c = 0; c < k; ++c) fn += row3(P, row[c]).cross(row3(P, row[(c + 1) % k]));
+            const Vec3 dir = plane.normal.cross(fn);
+            for (auto& [key, q] : cuts) key = dir.dot(q);
+            std::stable_sort(cuts.begin(), cuts.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+          }
+          for (std::size_t c = 0; c + 1 < cuts.size(); c += 2) out.push_back({cuts[c].second, cuts[c + 1].second});
         }
-        if (cuts.size() > 2) {
-          // Non-convex polygon: order the crossings along the cut line (plane
-          // normal x Newell face normal) and pair them up.
-          Vec3 fn = Vec3::Zero();
-          for (std::size_t c = 0; c < k; ++c) fn += row3(P, row[c]).cross(row3(P, row[(c + 1) % k]));
-          const Vec3 dir = plane.normal.cross(fn);
-          for (auto& [key, q] : cuts) key = dir.dot(q);
-          std::stable_sort(cuts.begin(), cuts.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-        }
-        for (std::size_t c = 0; c + 1 < cuts.size(); c += 2) out[blk].push_back({cuts[c].second, cuts[c + 1].second});
-      }
-    }
-  });
+      });
 
   SliceResult result;
   // Hanging edges cross in single points.
@@ -94,16 +87,11 @@ SliceResult slice_garment(const Garment& g, const FeaturePlane& plane, double we
   result.line_points.resize(static_cast<Eigen::Index>(lp.size()), 3);
   for (std::size_t i = 0; i < lp.size(); ++i) result.line_points.row(static_cast<Eigen::Index>(i)) = lp[i].transpose();
 
-  std::size_t total = 0;
-  for (const auto& o : out) total += o.size();
+  const std::size_t total = segments.size();
   Points ends(static_cast<Eigen::Index>(2 * total), 3);
-  {
-    Eigen::Index r = 0;
-    for (const auto& o : out)
-      for (const Segment& sg : o) {
-        ends.row(r++) = sg.a.transpose();
-        ends.row(r++) = sg.b.transpose();
-      }
+  for (std::size_t i = 0; i < total; ++i) {
+    ends.row(Eigen::Index(2 * i)) = segments[i].a.transpose();
+    ends.row(Eigen::Index(2 * i + 1)) = segments[i].b.transpose();
   }
   const std::vector<Index> rep = weld_points(ends, weld_tolerance);
   // Node ids in order of first appearance.

@@ -73,19 +73,14 @@ std::vector<std::pair<Index, Vec3>> GarmentMirror::paired_moving_rows(const Poin
   parallel_for(0, n, 4096, [&](std::size_t b, std::size_t e) {
     for (std::size_t v = b; v < e; ++v) moved[v] = after.row(Eigen::Index(v)) != before.row(Eigen::Index(v));
   });
-  constexpr std::size_t kBlock = 4096;
-  std::vector<std::vector<std::pair<Index, Vec3>>> rows((n + kBlock - 1) / kBlock);
-  parallel_for(0, rows.size(), 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t k = b; k < e; ++k)
-      for (std::size_t v = k * kBlock; v < std::min(n, (k + 1) * kBlock); ++v) {
-        const auto& image = images_.vertex[v];
-        if (!paired[v] || !(moved[v] || moved[image[0]] || moved[image[1]] || moved[image[2]])) continue;
-        if (const std::optional<Vec3> p = row(Index(v))) rows[k].emplace_back(Index(v), *p);
-      }
-  });
-  std::vector<std::pair<Index, Vec3>> out;
-  for (const auto& r : rows) out.insert(out.end(), r.begin(), r.end());
-  return out;
+  return gather_in_blocks<std::pair<Index, Vec3>>(
+      n, 4096, [&](std::size_t first, std::size_t last, std::vector<std::pair<Index, Vec3>>& out) {
+        for (std::size_t v = first; v < last; ++v) {
+          const auto& image = images_.vertex[v];
+          if (!paired[v] || !(moved[v] || moved[image[0]] || moved[image[1]] || moved[image[2]])) continue;
+          if (const std::optional<Vec3> p = row(Index(v))) out.emplace_back(Index(v), *p);
+        }
+      });
 }
 
 // The snap moves a few thousand vertices of a million: only those and the

@@ -20,27 +20,12 @@ constexpr std::size_t kFoldGrain = 4096;
 // the other way is no fold.
 constexpr double kSmoothAround = 0.5;
 
-// What emit(k, out) appends for k = 0 .. n - 1, in that order: run in
-// parallel, in fixed blocks whose lists are joined in order (the same list for
-// any thread count). emit may write only to what k alone owns.
-template <class Emit>
-std::vector<Index> gathered(std::size_t n, const Emit& emit) {
-  const std::size_t blocks = (n + kFoldGrain - 1) / kFoldGrain;
-  std::vector<std::vector<Index>> found(blocks);
-  parallel_for(0, blocks, 1, [&](std::size_t b, std::size_t e) {
-    for (std::size_t blk = b; blk < e; ++blk)
-      for (std::size_t k = blk * kFoldGrain; k < std::min(n, (blk + 1) * kFoldGrain); ++k) emit(k, found[blk]);
-  });
-  std::vector<Index> out;
-  for (const auto& list : found) out.insert(out.end(), list.begin(), list.end());
-  return out;
-}
-
 // The entries of `list` with keep(entry), in order.
 template <class Keep>
 std::vector<Index> entries_where(std::span<const Index> list, const Keep& keep) {
-  return gathered(list.size(), [&](std::size_t k, std::vector<Index>& out) {
-    if (keep(list[k])) out.push_back(list[k]);
+  return gather_in_blocks<Index>(list.size(), kFoldGrain, [&](std::size_t first, std::size_t last, std::vector<Index>& out) {
+    for (std::size_t k = first; k < last; ++k)
+      if (keep(list[k])) out.push_back(list[k]);
   });
 }
 
@@ -50,9 +35,10 @@ std::vector<Index> entries_where(std::span<const Index> list, const Keep& keep) 
 // pass over the list.
 template <class Take>
 std::vector<Index> neighbours_where(const Csr& adjacency, std::span<const Index> from, const Take& take) {
-  return gathered(from.size(), [&](std::size_t k, std::vector<Index>& out) {
-    for (Index w : adjacency.row(from[k]))
-      if (take(w)) out.push_back(w);
+  return gather_in_blocks<Index>(from.size(), kFoldGrain, [&](std::size_t first, std::size_t last, std::vector<Index>& out) {
+    for (std::size_t k = first; k < last; ++k)
+      for (Index w : adjacency.row(from[k]))
+        if (take(w)) out.push_back(w);
   });
 }
 
@@ -143,8 +129,9 @@ struct Orientation {
   // parallel (each its own); returns their indices ascending.
   template <class Hit>
   static std::vector<Index> marked(std::vector<std::uint32_t>& marks, std::uint32_t mark, const Hit& hit) {
-    return gathered(marks.size(), [&](std::size_t i, std::vector<Index>& out) {
-      if (marks[i] != mark && hit(Index(i))) marks[i] = mark, out.push_back(Index(i));
+    return gather_in_blocks<Index>(marks.size(), kFoldGrain, [&](std::size_t first, std::size_t last, std::vector<Index>& out) {
+      for (std::size_t i = first; i < last; ++i)
+        if (marks[i] != mark && hit(Index(i))) marks[i] = mark, out.push_back(Index(i));
     });
   }
   bool retested(Index f) const { return !face_mark.empty() && face_mark[f] == stamp; }
