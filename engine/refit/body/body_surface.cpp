@@ -114,8 +114,7 @@ void collect_filter(const RTCFilterFunctionNArguments* args) {
 }
 
 struct PointQueryData {
-  const Points* vertices;
-  const std::vector<std::array<Index, 3>>* triangles;
+  const std::vector<std::array<Vec3, 3>>* corners;  // per triangle
   const std::vector<std::uint8_t>* degenerate;
   Vec3 p;
   double best_d2 = kInf;
@@ -128,8 +127,8 @@ struct PointQueryData {
 // (its points lie on neighbours' edges anyway).
 std::optional<TrianglePoint> triangle_point(const PointQueryData& d, Index t) {
   if ((*d.degenerate)[t]) return std::nullopt;
-  const auto& tri = (*d.triangles)[t];
-  return closest_on_triangle(d.p, row3(*d.vertices, tri[0]), row3(*d.vertices, tri[1]), row3(*d.vertices, tri[2]));
+  const auto& c = (*d.corners)[t];
+  return closest_on_triangle(d.p, c[0], c[1], c[2]);
 }
 
 bool point_query_callback(RTCPointQueryFunctionArguments* args) {
@@ -256,6 +255,9 @@ struct BodySurface::Impl {
   RTCScene scene = nullptr;
   Points vertices;
   std::vector<std::array<Index, 3>> triangles;
+  // Each triangle's corners side by side: a point query reads one triangle's from
+  // one place, not from the three columns of `vertices` at three rows.
+  std::vector<std::array<Vec3, 3>> corners;
   Points face_normal;                     // unit, zero for degenerate triangles
   std::vector<std::uint8_t> degenerate;
   Points edge_normal;                     // row 3t+k: sum of the normals of the faces on edge k of t
@@ -297,7 +299,7 @@ struct BodySurface::Impl {
   }
 
   PointQueryData query(const Vec3& p, double max_distance) const {
-    PointQueryData d{&vertices, &triangles, &degenerate, p};
+    PointQueryData d{&corners, &degenerate, p};
     point_query(p, max_distance, point_query_callback, &d);
     if (d.best_d2 > max_distance * max_distance) d.best_d2 = kInf;
     return d;
@@ -524,10 +526,12 @@ BodySurface::BodySurface(const BodyMesh& body, std::shared_ptr<const BodyTopolog
   // Face normals, degenerate triangles, bounding box, signed volume.
   m.face_normal.setZero(nt, 3);
   m.degenerate.assign(nt, 0);
+  m.corners.resize(std::size_t(nt));
   double volume = 0.0;
   for (Index t = 0; t < nt; ++t) {
     const auto& tri = m.triangles[t];
     const Vec3 a = row3(m.vertices, tri[0]), b = row3(m.vertices, tri[1]), c = row3(m.vertices, tri[2]);
+    m.corners[std::size_t(t)] = {a, b, c};
     const Vec3 n = (b - a).cross(c - a);
     const double len = n.norm();
     const double scale2 = std::max({(b - a).squaredNorm(), (c - a).squaredNorm(), (c - b).squaredNorm()});
@@ -632,7 +636,7 @@ bool BodySurface::closer_than(const Vec3& p, double max_distance) const {
 
 bool BodySurface::closer_than(const Vec3& p, double max_distance, Index& hint) const {
   if (!p.allFinite() || !(max_distance > 0.0)) return false;
-  CloserThanData d{{&impl_->vertices, &impl_->triangles, &impl_->degenerate, p}, max_distance};
+  CloserThanData d{{&impl_->corners, &impl_->degenerate, p}, max_distance};
   if (hint < impl_->triangles.size() && closer_than_test(d, hint)) return true;
   impl_->point_query(p, max_distance, closer_than_callback, &d);
   if (d.found) hint = d.tri;
