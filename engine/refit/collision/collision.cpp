@@ -447,10 +447,11 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     const bool scan = all || !few_vertices(count, n);
     const std::vector<Index> listed = scan ? std::vector<Index>{} : faces_around(faces_of(), to_check);
     const std::size_t asked = scan ? nf : listed.size();
-    std::atomic<std::size_t> faces_in{0};
+    std::atomic<std::size_t> faces_in{0};  // added to once a block
     Found face_found = gather_in_blocks<Found::value_type>(
         asked, kBlock, [&](std::size_t first, std::size_t last, Found& out) {
           std::vector<Constraint> need;
+          std::size_t in_here = 0;
           for (std::size_t k = first; k < last; ++k) {
             const std::size_t f = scan ? k : std::size_t(listed[k]);
             const auto face = g.faces.row(f);
@@ -469,13 +470,14 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
             const bool in =
                 face_needs(g, positions, f, body_b, options.face_clearance, options.probe_radius, options.pinned,
                            &outside_by, waits ? nullptr : &need);
-            if (in) ++faces_in;
+            in_here += in;
             if (!in) clear_at[f] = moves_done + 1;
             if (all) face_inside_before[f] = in;
             if (waits) continue;
             for (std::size_t i = 0; i < face.size(); ++i)
               if (need[i].active) out.emplace_back(face[i], need[i]);
           }
+          faces_in += in_here;
         });
     // Layers: an outer point closer to its inner vertex than it keeps. The inner
     // vertex goes down by what it may (the outer layer is what shows, and the
@@ -484,9 +486,10 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
     const std::size_t face_own = face_found.size();  // the faces' own, before the layers'
     if (options.layers) {
       const auto& covers = *options.layers;
-      std::atomic<std::size_t> crossed{0};
+      std::atomic<std::size_t> crossed{0};  // added to once a block
       const Found layer_found = gather_in_blocks<Found::value_type>(
           covers.size(), kBlock, [&](std::size_t first, std::size_t last, Found& out) {
+            std::size_t crossed_here = 0;
             for (std::size_t k = first; k < last; ++k) {
               const LayerCover& c = covers[k];
               const bool check = all || check_face_of[c.inner] || check_face_of[c.outer[0]] || check_face_of[c.outer[1]] ||
@@ -496,7 +499,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
               const auto [height, normal] = cover_height(c, positions);
               const double rounding = kCoverRounding * (1.0 + row3(positions, c.inner).cwiseAbs().maxCoeff());
               if (!(height < c.keep - rounding)) continue;
-              ++crossed;
+              ++crossed_here;
               const double short_by = c.keep - height;
               // It sinks by at most max_lift from where the step found it, as a vertex
               // near the body rises by at most that beyond its need.
@@ -532,6 +535,7 @@ CollisionReport resolve_penetrations(const Garment& g, Points& positions, const 
                 if (w[std::size_t(j)] > 0.0)
                   out.emplace_back(c.outer[std::size_t(j)], Constraint{normal, up * w[std::size_t(j)] / norm2, true, false});
             }
+            crossed += crossed_here;
           });
       face_found.insert(face_found.end(), layer_found.begin(), layer_found.end());
       if (all) {
