@@ -69,7 +69,8 @@ Points crumpled(const Garment& g, const Eigen::Matrix3d& map) {
 
 // The grid, what the smoothing needs of it, and the smooth map.
 struct Grid {
-  Garment g = grid();
+  explicit Grid(int side = kSide) : g(grid(side)) {}
+  Garment g;
   Csr adjacency = vertex_adjacency(g);
   FoldBinding binding = bind_folds(g);
   Eigen::Matrix3d map = smooth_map();
@@ -141,10 +142,9 @@ TEST(Folds, AFoldLeftOverGetsAWiderRegion) {
 // smoothed as it is beside the patch.
 TEST(Folds, ALaterRoundLeavesPiecesWithNoFoldLeft) {
   constexpr int side = 41;
-  const Garment g = grid(side);
-  const Csr adjacency = vertex_adjacency(g);
-  const FoldBinding binding = bind_folds(g);
-  const Eigen::Matrix3d map = smooth_map();
+  const Grid big(side);
+  const Garment& g = big.g;
+  const Eigen::Matrix3d& map = big.map;
   const Points smooth = deformed(g, map);
   const Index crumple = Index(30 * side + 30);
   Points crumple_only = smooth;
@@ -156,8 +156,8 @@ TEST(Folds, ALaterRoundLeavesPiecesWithNoFoldLeft) {
   narrow.rings = 1;
   narrow.feather = 0;
   narrow.reshape_rounds = 0;
-  const FoldReport r_crumple = smooth_out_folds(g, binding, crumple_only, adjacency, nullptr, narrow);
-  const FoldReport r_both = smooth_out_folds(g, binding, both, adjacency, nullptr, narrow);
+  const FoldReport r_crumple = smooth_out_folds(g, big.binding, crumple_only, big.adjacency, nullptr, narrow);
+  const FoldReport r_both = smooth_out_folds(g, big.binding, both, big.adjacency, nullptr, narrow);
   EXPECT_EQ(r_crumple.folded_after, 0u);
   EXPECT_EQ(r_both.folded_after, 0u);
   ASSERT_GT(r_both.rounds, r_crumple.rounds);  // the patch took more rounds than the crumple
@@ -254,10 +254,11 @@ TEST(Folds, FacesLeftTurnedTakeTheirOriginalShapeTurnedAsAround) {
 // smooths to the same bits with one thread and with two.
 TEST(Folds, TheSameWithOneThreadOrTwo) {
   constexpr int kBig = 160;
-  const Garment g = grid(kBig);
-  const Csr adjacency = vertex_adjacency(g);
-  const FoldBinding binding = bind_folds(g);
-  const Eigen::Matrix3d map = smooth_map();
+  const Grid big(kBig);
+  const Garment& g = big.g;
+  const Csr& adjacency = big.adjacency;
+  const FoldBinding& binding = big.binding;
+  const Eigen::Matrix3d& map = big.map;
   Points crumples = deformed(g, map);
   for (int i = 10; i < kBig; i += 14)
     for (int k = 10; k < kBig; k += 14)
