@@ -199,6 +199,29 @@ TEST(Cli, ManyBodiesSkipTheBadOneAndWriteTheOthers) {
   EXPECT_EQ(j["bodies"].size(), 3u);
 }
 
+// Each body's timings are what its total spent: the binding, made once, is in
+// the first body's report only, and a later body's load is reading its body.
+TEST(Cli, ManyBodiesReportTheBindingOnce) {
+  const Case c;
+  const std::string dir = c.dir.file("out");
+  const auto r = run_cli("resize --quiet --no-collision --garment '" + c.garment + "' --from '" + c.a + "' --to '" +
+                         c.b + "' '" + c.a + "' --out-dir '" + dir + "' --report '" + c.dir.file("r.json") + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(test::read_text(c.dir.file("r.json")));
+  ASSERT_EQ(j["bodies"].size(), 2u);
+  const auto& first = j["bodies"][0]["timings_ms"];
+  const auto& second = j["bodies"][1]["timings_ms"];
+  EXPECT_TRUE(first.contains("bind"));
+  EXPECT_FALSE(second.contains("bind"));
+  for (const auto* t : {&first, &second}) {
+    double stages = 0.0;  // the stages a body spent add up to no more than its total
+    for (const char* key : {"load", "warp", "features", "surface", "write"}) stages += t->value(key, 0.0);
+    if (t->contains("bind"))
+      for (const auto& [name, ms] : t->at("bind").items()) stages += ms.get<double>();
+    EXPECT_LE(stages, t->value("total", 0.0) * 1.01 + 1.0) << t->dump();
+  }
+}
+
 struct BadInput {
   std::string name, file_text, which, expect;  // which: garment, from, to, features
 };
