@@ -417,7 +417,7 @@ def main():
             subprocess.run([sys.executable, os.path.join(data, "make_dense.py"), os.path.join(data, "garments", GARMENTS[source][0]),
                             os.path.join(out_dir, name + ".obj"), "--min-vertices", str(vertices)], check=True,
                            capture_output=True)
-        garments = list(garments) + list(DENSE)
+        garments = list(garments) + [name for name in DENSE if name not in garments]  # once, if named too
     targets = TARGETS
     if args.check_bodies:
         targets = {a: [t for t, (base, _) in CHECK.items() if base == a] for a in TARGETS}
