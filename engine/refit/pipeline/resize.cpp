@@ -9,6 +9,7 @@
 #include <refit/metrics/metrics.hpp>
 #include <refit/pipeline/resize.hpp>
 #include <refit/pipeline/input_checks.hpp>
+#include <refit/pipeline/last_folds.hpp>
 #include <refit/pipeline/resize_report.hpp>
 #include <refit/pipeline/units.hpp>
 
@@ -560,6 +561,12 @@ void GarmentBinding::collision_step(const BodySurface& surface_b, bool symmetric
   co.faces_of_vertex = &folds_once().faces_of_vertex;  // made once, with the folds' binding
   if (!layer_covers_.empty()) co.layers = &layer_covers_;
   const CollisionReport c = resolve_penetrations(*garment_, result.positions, surface_b, co);
+  LastFoldsReport last;
+  if (options_.smooth_folds) {
+    const Stopwatch folds_clock;
+    last = smooth_out_last_folds(*garment_, folds_once(), result.positions, adjacency, keep, surface_b, co.clearance);
+    folds_ms += folds_clock.ms();
+  }
   result.report["timings_ms"]["collision"] = clock.ms();
   result.report["collision"] = c.to_json();
   if (symmetric_b) result.report["collision"]["not_pushed_alike"] = mirror_.pushed_apart();  // images on another layer
@@ -569,6 +576,8 @@ void GarmentBinding::collision_step(const BodySurface& surface_b, bool symmetric
     };
     result.report["collision"]["folds"] = figures(folds);
     result.report["collision"]["folds"]["after_pushes"] = figures(folds_after);
+    result.report["collision"]["folds"]["after_rounds"] = figures(last.folds);
+    result.report["collision"]["folds"]["after_rounds"]["held"] = last.held;
     result.report["timings_ms"]["collision_folds"] = folds_ms;  // part of the collision step's
   }
   if (c.inside_after > 0)
